@@ -1,0 +1,83 @@
+#include "result_report.h"
+
+#include <fmt/format.h>
+
+#include "k4reg/matrix_file.h"
+
+namespace k4reg::cli {
+namespace {
+
+nlohmann::json matrix_to_json(const Eigen::Matrix4d& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) rows.push_back(m(r, c));
+  return rows;  // row-major, 16 numbers
+}
+
+}  // namespace
+
+nlohmann::json result_to_json(const RegistrationResult& r) {
+  nlohmann::json j;
+  j["transform"] = matrix_to_json(r.transform);
+  j["rmse_m"] = r.rmse_m;
+  j["overlap"] = r.overlap;
+  j["inliers"] = r.inliers;
+  j["source_points"] = r.source_points;
+  j["target_points"] = r.target_points;
+  j["source_voxels"] = r.source_voxels;
+  j["target_voxels"] = r.target_voxels;
+  j["source_keypoints"] = r.source_keypoints;
+  j["target_keypoints"] = r.target_keypoints;
+  j["signal"] = r.signal;
+  j["ambiguity_margin"] = r.ambiguity_margin;
+  j["bases_tried"] = r.bases_tried;
+  j["seed"] = r.seed;
+  j["icp_converged"] = r.icp_converged;
+  j["icp_iterations"] = r.icp_iterations;
+  j["hypotheses"] = nlohmann::json::array();
+  for (const Hypothesis& h : r.hypotheses)
+    j["hypotheses"].push_back(
+        {{"transform", matrix_to_json(h.transform)}, {"keypoint_score", h.keypoint_score}, {"cloud_score", h.cloud_score}});
+  j["timings"] = nlohmann::json::array();
+  for (const StageTiming& t : r.timings) j["timings"].push_back({{"stage", t.stage}, {"seconds", t.seconds}});
+  return j;
+}
+
+void print_result_table(std::ostream& out, const RegistrationResult& r) {
+  out << "transform (source -> target):\n" << format_matrix4(r.transform);
+  out << fmt::format("{:<22}{:.4f} m\n", "rmse", r.rmse_m);
+  out << fmt::format("{:<22}{:.1f} %\n", "overlap", 100.0 * r.overlap);
+  out << fmt::format("{:<22}{}\n", "inliers", r.inliers);
+  out << fmt::format("{:<22}{} / {}\n", "points", r.source_points, r.target_points);
+  out << fmt::format("{:<22}{} / {} ({})\n", "keypoints", r.source_keypoints, r.target_keypoints, r.signal);
+  out << fmt::format("{:<22}{:.3f}{}\n", "ambiguity margin", r.ambiguity_margin,
+                     r.ambiguity_margin < 0.05 ? "  (ambiguous: check the runner-up hypotheses)" : "");
+  out << fmt::format("{:<22}{}\n", "hypotheses", r.hypotheses.size());
+  for (std::size_t k = 0; k < r.hypotheses.size(); ++k)
+    out << fmt::format("  #{}  cloud score {:.3f}  keypoint score {:.3f}\n", k + 1, r.hypotheses[k].cloud_score,
+                       r.hypotheses[k].keypoint_score);
+  out << fmt::format("{:<22}{}\n", "seed", r.seed);
+  double total = 0;
+  for (const StageTiming& t : r.timings) {
+    out << fmt::format("  {:<20}{:.3f} s\n", t.stage, t.seconds);
+    total += t.seconds;
+  }
+  out << fmt::format("{:<22}{:.3f} s\n", "total", total);
+}
+
+nlohmann::json error_to_json(const TransformError& e, bool success) {
+  return {{"mae_deg", e.mae_deg}, {"mte_m", e.mte_m}, {"rotation_error_deg", e.rotation_deg},
+          {"translation_error_m", e.translation_m}, {"rmse_m", e.rmse_m}, {"success", success}};
+}
+
+void print_error_table(std::ostream& out, const TransformError& e, bool success) {
+  out << "against ground truth:\n";
+  out << fmt::format("  {:<20}{:.4f} deg\n", "MAE", e.mae_deg);
+  out << fmt::format("  {:<20}{:.4f} m\n", "MTE", e.mte_m);
+  out << fmt::format("  {:<20}{:.4f} deg\n", "rotation error", e.rotation_deg);
+  out << fmt::format("  {:<20}{:.4f} m\n", "translation error", e.translation_m);
+  out << fmt::format("  {:<20}{:.4f} m\n", "RMSE", e.rmse_m);
+  out << fmt::format("  {:<20}{}\n", "success", success ? "yes" : "no");
+}
+
+}  // namespace k4reg::cli

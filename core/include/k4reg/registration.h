@@ -1,0 +1,91 @@
+// K-4PCS pairwise registration (Theiler, Wegner, Schindler 2014), top to bottom:
+//   voxel grid (centroids, spacing = min scale)  ->  3D DoG keypoints  ->  keypoint 4PCS
+//   ->  symmetry guard (re-score the best distinct hypotheses on the voxelised clouds)  ->  ICP.
+// Cost: linear in the input points for the voxel grid; the rest depends on the voxel / keypoint counts.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "k4reg/cancellation.h"
+#include "k4reg/point_cloud.h"
+
+namespace k4reg {
+
+enum class CoarseMethod {
+  kKeypoint4pcs,  // K-4PCS: 4PCS on DoG keypoints (the paper's method)
+  kPlain4pcs,     // baseline: 4PCS on a coarser voxel grid (the paper's Sec. 3.1)
+};
+
+enum class KeypointSignal {
+  kAuto,        // intensity when both clouds have it, otherwise geometric
+  kIntensity,   // DoG of the (voxel-averaged) intensity
+  kGeometric,   // DoG of the surface variation from local PCA (clouds without intensity)
+};
+
+struct RegistrationParams {
+  // The two parameters that matter (paper Tab. 1).
+  double min_scale_m = 0.05;  // minimum DoG scale sigma; also the voxel grid spacing
+  double overlap = 0.8;       // approximate overlap of the two scans, (0, 1]
+
+  // DoG detector (paper Tab. 1 defaults).
+  int octaves = 5;
+  int scales_per_octave = 5;
+  double min_contrast = 0.01;  // fraction of the signal's range
+  KeypointSignal signal = KeypointSignal::kAuto;
+
+  // 4PCS.
+  CoarseMethod method = CoarseMethod::kKeypoint4pcs;
+  double plain_voxel_m = 0.0;  // voxel spacing for kPlain4pcs; 0 = chosen to give ~ as many points as keypoints
+  int max_bases = 0;           // number of 4-point bases L; 0 = from the overlap
+  int hypotheses_kept = 5;     // distinct hypotheses re-scored by the symmetry guard
+
+  // ICP refinement.
+  bool icp = true;
+  int icp_max_iterations = 50;
+
+  std::uint64_t seed = 42;
+  int threads = 0;             // 0 = all cores
+  double time_budget_s = 0.0;  // 0 = unlimited; otherwise kDeadlineExceeded after this long
+};
+
+struct Hypothesis {
+  Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();  // source -> target
+  double keypoint_score = 0.0;  // share of source keypoints with a target keypoint in tolerance
+  double cloud_score = 0.0;     // share of voxelised source points with a target point in tolerance
+};
+
+struct StageTiming {
+  std::string stage;
+  double seconds = 0.0;
+};
+
+struct RegistrationResult {
+  Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();  // source -> target, in the files' frames
+  double rmse_m = 0.0;          // RMS of the inlier residuals after refinement
+  double overlap = 0.0;         // share of voxelised source points with a target neighbour after alignment
+  std::size_t inliers = 0;
+  std::size_t source_points = 0, target_points = 0;
+  std::size_t source_voxels = 0, target_voxels = 0;
+  std::size_t source_keypoints = 0, target_keypoints = 0;
+  std::string signal;           // "intensity" or "geometric" (or "voxels" for plain 4PCS)
+  double ambiguity_margin = 0.0;  // (best - runner-up) / best cloud score; small = ambiguous (e.g. symmetry)
+  std::vector<Hypothesis> hypotheses;  // best first
+  int bases_tried = 0;
+  std::uint64_t seed = 0;
+  bool icp_converged = false;
+  int icp_iterations = 0;
+  std::vector<StageTiming> timings;
+};
+
+// Registers source onto target. Throws k4reg::Error: kInvalidArgument for empty/degenerate clouds or
+// parameters out of range, kFailedPrecondition when too few keypoints or no hypothesis is found,
+// kCancelled / kDeadlineExceeded when stopped. Thread-safe: independent calls may run concurrently.
+// Deterministic: the same inputs and seed give the same transform for any thread count.
+RegistrationResult register_clouds(const PointCloud& source, const PointCloud& target,
+                                   const RegistrationParams& params, const CancellationToken* cancel = nullptr,
+                                   const ProgressCallback& progress = {});
+
+}  // namespace k4reg

@@ -1,0 +1,131 @@
+#include "k4reg/dog_keypoints.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "k4reg/error.h"
+#include "k4reg/neighbor_grid.h"
+#include "k4reg/voxel_grid.h"
+
+namespace k4reg {
+namespace {
+
+// Gaussians are cut at 2.5 sigma (weight 4%): the tail changes the mean by far less than the noise.
+constexpr double kKernelRadius = 2.5;
+
+float robust_range(std::vector<float> values) {
+  if (values.empty()) return 0.0f;
+  const std::size_t lo = values.size() / 200, hi = values.size() - 1 - values.size() / 200;
+  std::nth_element(values.begin(), values.begin() + lo, values.end());
+  const float low = values[lo];
+  std::nth_element(values.begin(), values.begin() + hi, values.end());
+  return values[hi] - low;
+}
+
+// One octave: points at spacing h with their signal; appends its keypoints to out.
+void detect_octave(const std::vector<Eigen::Vector3f>& points, const std::vector<float>& signal, double h,
+                   double contrast, const DogParams& params, const CancellationToken* cancel, DogKeypoints& out) {
+  const int levels = params.scales_per_octave + 3;  // Gaussian scales; levels - 1 DoG layers
+  const int dogs = levels - 1;
+  const std::size_t n = points.size();
+  std::vector<double> sigma(levels);
+  for (int j = 0; j < levels; ++j) sigma[j] = h * std::pow(2.0, static_cast<double>(j) / params.scales_per_octave);
+  const float radius = static_cast<float>(kKernelRadius * sigma.back());
+  const NeighborGrid grid(points, radius);
+
+  std::vector<float> dog(n * dogs, 0.0f);
+  std::vector<std::uint8_t> stable(n * dogs, 0);  // DoG layer j is trustworthy at point i
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& range) {
+    check(cancel);
+    std::vector<double> w_sum(levels), s_sum(levels), inv2s2(levels);
+    std::vector<Eigen::Vector3d> c_sum(levels);
+    for (int j = 0; j < levels; ++j) inv2s2[j] = 1.0 / (2.0 * sigma[j] * sigma[j]);
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      std::fill(w_sum.begin(), w_sum.end(), 0.0);
+      std::fill(s_sum.begin(), s_sum.end(), 0.0);
+      std::fill(c_sum.begin(), c_sum.end(), Eigen::Vector3d::Zero());
+      grid.for_each_within(points[i], radius, [&](std::uint32_t k, float d2) {
+        const Eigen::Vector3d offset = (points[k] - points[i]).cast<double>();
+        for (int j = 0; j < levels; ++j) {
+          const double w = std::exp(-d2 * inv2s2[j]);
+          w_sum[j] += w;
+          s_sum[j] += w * signal[k];
+          c_sum[j] += w * offset;
+        }
+      });
+      // A fully sampled plane at spacing h gives sum(w) = 2 pi sigma^2 / h^2.
+      auto ok = [&](int j) {
+        const double coverage = w_sum[j] * h * h / (2.0 * M_PI * sigma[j] * sigma[j]);
+        const double border = (c_sum[j] / w_sum[j]).norm() / sigma[j];
+        return coverage >= params.min_coverage && border <= params.max_border_offset;
+      };
+      bool previous_ok = ok(0);
+      for (int j = 0; j < dogs; ++j) {
+        const bool next_ok = ok(j + 1);
+        dog[i * dogs + j] = static_cast<float>(s_sum[j + 1] / w_sum[j + 1] - s_sum[j] / w_sum[j]);
+        stable[i * dogs + j] = previous_ok && next_ok;
+        previous_ok = next_ok;
+      }
+    }
+  });
+
+  // Extrema over the neighbours within the scale (at least the 26-neighbourhood) and the adjacent layers.
+  std::vector<std::vector<int>> found(n);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& range) {
+    check(cancel);
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      for (int j = 1; j + 1 < dogs; ++j) {
+        const float v = dog[i * dogs + j];
+        if (!stable[i * dogs + j] || std::abs(v) < contrast) continue;
+        const float r = static_cast<float>(std::max(1.75 * h, sigma[j]));
+        bool is_max = v > dog[i * dogs + j - 1] && v > dog[i * dogs + j + 1];
+        bool is_min = v < dog[i * dogs + j - 1] && v < dog[i * dogs + j + 1];
+        if (!is_max && !is_min) continue;
+        grid.for_each_within(points[i], r, [&](std::uint32_t k, float) {
+          if (k == i) return;
+          for (int dj = -1; dj <= 1; ++dj) {
+            const float u = dog[k * dogs + j + dj];
+            is_max = is_max && v > u;
+            is_min = is_min && v < u;
+          }
+        });
+        if (is_max || is_min) found[i].push_back(j);
+      }
+    }
+  });
+  for (std::size_t i = 0; i < n; ++i)
+    for (int j : found[i]) {
+      out.points.push_back(points[i]);
+      out.scale_m.push_back(static_cast<float>(sigma[j]));
+      out.response.push_back(dog[i * dogs + j]);
+    }
+}
+
+}  // namespace
+
+DogKeypoints detect_dog_keypoints(const std::vector<Eigen::Vector3f>& points, const std::vector<float>& signal,
+                                  const DogParams& params, const CancellationToken* cancel) {
+  if (signal.size() != points.size()) fail(ErrorCode::kInternal, "DoG: signal and points differ in size");
+  if (params.octaves < 1 || params.scales_per_octave < 1)
+    fail(ErrorCode::kInvalidArgument, "DoG: octaves and scales_per_octave must be at least 1");
+  const double contrast = params.min_contrast * robust_range(signal);
+
+  DogKeypoints out;
+  PointCloud octave;
+  octave.points = points;
+  octave.intensity = signal;
+  double h = params.min_scale_m;
+  for (int o = 0; o < params.octaves; ++o) {
+    if (o > 0) {
+      h *= 2.0;
+      octave = voxel_grid(octave, h, cancel).cloud;  // averages positions and signal per coarser voxel
+    }
+    if (octave.size() < 27) break;  // nothing left to find extrema in
+    detect_octave(octave.points, octave.intensity, h, contrast, params, cancel, out);
+  }
+  return out;
+}
+
+}  // namespace k4reg

@@ -1,0 +1,170 @@
+#include "k4reg/four_pcs.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+#include "k4reg/congruent_sets.h"
+#include "k4reg/error.h"
+#include "k4reg/metrics.h"
+#include "k4reg/neighbor_grid.h"
+#include "k4reg/rigid_fit.h"
+
+namespace k4reg {
+namespace {
+
+constexpr int kBatch = 8;               // bases per parallel batch (fixed: determinism)
+constexpr int kPrescreenPoints = 40;    // cheap first look before a full verification
+constexpr double kInlierFactor = 3.0;   // inlier distance in units of delta
+
+// Robust extent of a cloud: the diagonal of the 2nd..98th percentile box, blind to a few far outliers.
+double robust_diameter(const std::vector<Eigen::Vector3f>& points) {
+  Eigen::Vector3d extent;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<float> v(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) v[i] = points[i][axis];
+    const std::size_t lo = v.size() / 50, hi = v.size() - 1 - v.size() / 50;
+    std::nth_element(v.begin(), v.begin() + lo, v.end());
+    const float low = v[lo];
+    std::nth_element(v.begin(), v.begin() + hi, v.end());
+    extent[axis] = v[hi] - low;
+  }
+  return extent.norm();
+}
+
+// MSAC-style score: each point contributes 1 - d^2/tau^2 when within tau of a target point.
+class Verifier {
+ public:
+  Verifier(const std::vector<Eigen::Vector3f>& source, const std::vector<Eigen::Vector3f>& target, double tau_m,
+           int max_points, std::uint64_t seed)
+      : grid_(target, 2.0 * tau_m), tau_(static_cast<float>(tau_m)) {  // 8-cell look-ups
+    std::vector<std::uint32_t> order(source.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::mt19937_64 rng(seed);
+    std::shuffle(order.begin(), order.end(), rng);
+    order.resize(std::min<std::size_t>(order.size(), max_points));
+    for (std::uint32_t i : order) points_.push_back(source[i]);
+  }
+
+  std::size_t size() const { return points_.size(); }
+
+  // Score over points [0, count), stopping early once it cannot reach `beat`.
+  double score(const Eigen::Matrix4d& t, std::size_t count, double beat) const {
+    const Eigen::Affine3f a = to_affine3f(t);
+    const float inv_tau2 = 1.0f / (tau_ * tau_);
+    double s = 0;
+    for (std::size_t k = 0; k < count; ++k) {
+      float d2 = 0;
+      if (grid_.nearest_within(a * points_[k], tau_, &d2) >= 0) s += 1.0 - d2 * inv_tau2;
+      if (s + static_cast<double>(count - k - 1) < beat) return -1.0;
+    }
+    return s;
+  }
+
+ private:
+  NeighborGrid grid_;
+  float tau_;
+  std::vector<Eigen::Vector3f> points_;
+};
+
+struct BaseOutcome {
+  bool found = false;
+  double score = -1;
+  Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();
+  std::size_t sets = 0;
+};
+
+}  // namespace
+
+int bases_for_overlap(double overlap) {
+  const double o = std::clamp(overlap, 0.05, 1.0);
+  const double first_estimate = std::log(1e-5) / std::log(std::max(1e-12, 1.0 - std::pow(o, 4)));
+  return std::max(4, static_cast<int>(std::ceil(first_estimate / (0.3 * 2.0 * o))));
+}
+
+bool distinct_transforms(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b, double min_angle_deg,
+                         double min_translation_m) {
+  const double angle = rotation_angle_deg(a.topLeftCorner<3, 3>().transpose() * b.topLeftCorner<3, 3>());
+  const double shift = (a.topRightCorner<3, 1>() - b.topRightCorner<3, 1>()).norm();
+  return angle >= min_angle_deg || shift >= min_translation_m;
+}
+
+FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::vector<Eigen::Vector3f>& target,
+                         const FourPcsParams& params, const CancellationToken* cancel, const ProgressCallback& progress) {
+  if (source.size() < 4 || target.size() < 4)
+    fail(ErrorCode::kFailedPrecondition, "4PCS needs at least 4 points per cloud (got " + std::to_string(source.size()) +
+                                             " and " + std::to_string(target.size()) + ")");
+  const CongruenceTolerances tolerance = CongruenceTolerances::from_delta(params.delta_m);
+  // Bases as wide as the overlap allows (paper: from the overlap and the diameter), but not so narrow
+  // that the rotation is poorly determined.
+  const double max_width = std::max(params.overlap * robust_diameter(source), 10.0 * params.delta_m);
+  const double min_width = std::max(0.1 * max_width, 4.0 * params.delta_m);
+  const PairIndex pairs(target, min_width - tolerance.pair_m, max_width + tolerance.pair_m);
+  const Verifier verifier(source, target, kInlierFactor * params.delta_m, params.verification_points, params.seed);
+  const int bases = params.max_bases > 0 ? params.max_bases : bases_for_overlap(params.overlap);
+
+  std::vector<BaseOutcome> outcomes(bases);
+  double global_best = 0;  // from finished batches only, so pruning does not depend on timing
+  for (int start = 0; start < bases; start += kBatch) {
+    check(cancel);
+    const int end = std::min(bases, start + kBatch);
+    tbb::parallel_for(start, end, [&](int b) {
+      std::seed_seq seq{static_cast<std::uint64_t>(params.seed), static_cast<std::uint64_t>(b)};
+      std::mt19937_64 rng(seq);
+      Base base;
+      if (!select_base(source, min_width, max_width, tolerance.coplanarity_m, rng, base)) return;
+      std::vector<Quadrilateral> sets;
+      find_congruent_sets(base, target, pairs, tolerance, sets);
+      BaseOutcome& out = outcomes[b];
+      out.sets = sets.size();
+      Eigen::Matrix3Xd from(3, 4), to(3, 4);
+      for (int k = 0; k < 4; ++k) from.col(k) = base.point[k].cast<double>();
+      const double prescreen_fraction = std::min(1.0, double(kPrescreenPoints) / verifier.size());
+      for (std::size_t s = 0; s < sets.size(); ++s) {
+        if ((s & 255) == 0) check(cancel);
+        for (int k = 0; k < 4; ++k) to.col(k) = target[sets[s][k]].cast<double>();
+        const Eigen::Matrix4d t = fit_rigid(from, to);
+        if (fit_rms(t, from, to) > tolerance.fit_rms_m) continue;
+        const double beat = std::max(out.score, global_best);
+        // Prescreen on the first points: a hypothesis far below the best so far is not worth a full look.
+        const std::size_t few = std::min<std::size_t>(kPrescreenPoints, verifier.size());
+        const double partial = verifier.score(t, few, 0.0);
+        if (partial / prescreen_fraction < 0.5 * beat) continue;
+        const double full = verifier.score(t, verifier.size(), std::max(out.score, 0.5 * global_best));
+        if (full > out.score) out.found = true, out.score = full, out.transform = t;
+      }
+    });
+    for (int b = start; b < end; ++b) global_best = std::max(global_best, outcomes[b].score);
+    if (progress) progress("matching", double(end) / bases);
+  }
+
+  // Distinct hypotheses, best first (ties to the earlier base, so the order is deterministic).
+  std::vector<int> order;
+  FourPcsResult result;
+  result.bases_tried = bases;
+  for (int b = 0; b < bases; ++b) {
+    result.congruent_sets += outcomes[b].sets;
+    if (outcomes[b].found) order.push_back(b);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return outcomes[x].score > outcomes[y].score; });
+  for (int b : order) {
+    if (static_cast<int>(result.hypotheses.size()) >= params.hypotheses_kept) break;
+    const bool is_new = std::all_of(result.hypotheses.begin(), result.hypotheses.end(), [&](const Hypothesis& h) {
+      return distinct_transforms(h.transform, outcomes[b].transform, 10.0, 10.0 * params.delta_m);
+    });
+    if (!is_new) continue;
+    Hypothesis h;
+    h.transform = outcomes[b].transform;
+    h.keypoint_score = outcomes[b].score / verifier.size();
+    result.hypotheses.push_back(h);
+  }
+  if (result.hypotheses.empty())
+    fail(ErrorCode::kFailedPrecondition, "no alignment found: no congruent 4-point set among " + std::to_string(bases) +
+                                             " bases (is the overlap or the minimum scale right?)");
+  return result;
+}
+
+}  // namespace k4reg

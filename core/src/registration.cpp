@@ -1,0 +1,226 @@
+#include "k4reg/registration.h"
+
+#include <Eigen/Eigenvalues>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "k4reg/dog_keypoints.h"
+#include "k4reg/error.h"
+#include "k4reg/four_pcs.h"
+#include "k4reg/icp.h"
+#include "k4reg/neighbor_grid.h"
+#include "k4reg/rigid_fit.h"
+#include "k4reg/surface_signal.h"
+#include "k4reg/voxel_grid.h"
+
+namespace k4reg {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+class StageTimer {
+ public:
+  StageTimer(RegistrationResult& result, const ProgressCallback& progress) : result_(result), progress_(progress) {}
+  template <typename F>
+  auto run(const std::string& stage, F&& f) {
+    if (progress_) progress_(stage, 0.0);
+    const auto start = Clock::now();
+    auto value = f();
+    result_.timings.push_back({stage, std::chrono::duration<double>(Clock::now() - start).count()});
+    if (progress_) progress_(stage, 1.0);
+    return value;
+  }
+
+ private:
+  RegistrationResult& result_;
+  const ProgressCallback& progress_;
+};
+
+void validate(const RegistrationParams& p) {
+  auto bad = [](const std::string& what) { fail(ErrorCode::kInvalidArgument, what); };
+  if (!(p.min_scale_m >= 0.001 && p.min_scale_m <= 10.0)) bad("min_scale_m must be in [0.001, 10] m");
+  if (!(p.overlap >= 0.05 && p.overlap <= 1.0)) bad("overlap must be in [0.05, 1]");
+  if (p.octaves < 1 || p.octaves > 8) bad("octaves must be in [1, 8]");
+  if (p.scales_per_octave < 1 || p.scales_per_octave > 10) bad("scales_per_octave must be in [1, 10]");
+  if (!(p.min_contrast >= 0.0 && p.min_contrast < 1.0)) bad("min_contrast must be in [0, 1)");
+  if (p.max_bases < 0 || p.max_bases > 1000000) bad("max_bases must be in [0, 1e6]");
+  if (p.hypotheses_kept < 1 || p.hypotheses_kept > 100) bad("hypotheses_kept must be in [1, 100]");
+  if (p.icp_max_iterations < 0 || p.icp_max_iterations > 1000) bad("icp_max_iterations must be in [0, 1000]");
+  if (p.threads < 0 || p.threads > 1024) bad("threads must be in [0, 1024]");
+  if (!(p.time_budget_s >= 0.0) || !std::isfinite(p.time_budget_s)) bad("time_budget_s must be >= 0");
+  if (!(p.plain_voxel_m >= 0.0 && p.plain_voxel_m <= 100.0)) bad("plain_voxel_m must be in [0, 100] m");
+}
+
+// Refuses clouds that cannot define a rigid transform: empty, a single point, a line or a plane.
+void check_geometry(const std::vector<Eigen::Vector3f>& points, double scale_m, const char* name) {
+  if (points.size() < 10)
+    fail(ErrorCode::kInvalidArgument, std::string(name) + " cloud has " + std::to_string(points.size()) +
+                                          " occupied voxels at the minimum scale; at least 10 are needed");
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& p : points) mean += p.cast<double>();
+  mean /= points.size();
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& p : points) cov += (p.cast<double>() - mean) * (p.cast<double>() - mean).transpose();
+  cov /= points.size();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(cov, Eigen::EigenvaluesOnly);
+  const Eigen::Vector3d spread = solver.eigenvalues().cwiseMax(0.0).cwiseSqrt();  // ascending
+  if (spread(1) < scale_m)
+    fail(ErrorCode::kInvalidArgument, std::string(name) + " cloud is degenerate: all points lie on a line");
+  if (spread(0) < 0.5 * scale_m)
+    fail(ErrorCode::kInvalidArgument, std::string(name) + " cloud is degenerate: all points lie on a plane");
+}
+
+// Share of source points with a target point within tau after t.
+double coverage(const std::vector<Eigen::Vector3f>& source, const NeighborGrid& target_grid, const Eigen::Matrix4d& t,
+                float tau) {
+  const Eigen::Affine3f a = to_affine3f(t);
+  std::size_t hits = 0;
+  for (const auto& p : source) hits += target_grid.any_within(a * p, tau);
+  return source.empty() ? 0.0 : double(hits) / source.size();
+}
+
+// The voxel spacing at which a cloud keeps about `points` voxels (the paper's plain-4PCS baseline).
+double spacing_for_count(const PointCloud& voxels, double start_m, std::size_t points) {
+  double spacing = start_m;
+  for (int step = 0; step < 40 && voxel_grid(voxels, spacing).cloud.size() > points; ++step) spacing *= 1.25;
+  return spacing;
+}
+
+// Source -> target in the files' frames from the transform between the local (origin-shifted) frames.
+Eigen::Matrix4d to_file_frames(const Eigen::Matrix4d& local, const Eigen::Vector3d& source_origin,
+                               const Eigen::Vector3d& target_origin) {
+  Eigen::Matrix4d t = local;
+  t.topRightCorner<3, 1>() += target_origin - local.topLeftCorner<3, 3>() * source_origin;
+  return t;
+}
+
+RegistrationResult run(const PointCloud& source, const PointCloud& target, const RegistrationParams& params,
+                       const CancellationToken* cancel, const ProgressCallback& progress) {
+  RegistrationResult result;
+  result.seed = params.seed;
+  result.source_points = source.size();
+  result.target_points = target.size();
+  StageTimer timer(result, progress);
+  const double sigma = params.min_scale_m;
+
+  // 1. Voxel grid at the minimum scale (paper Sec. 2.1).
+  const auto [source_voxels, target_voxels] = timer.run("voxel_grid", [&] {
+    return std::make_pair(voxel_grid(source, sigma, cancel), voxel_grid(target, sigma, cancel));
+  });
+  result.source_voxels = source_voxels.cloud.size();
+  result.target_voxels = target_voxels.cloud.size();
+  check_geometry(source_voxels.cloud.points, sigma, "source");
+  check_geometry(target_voxels.cloud.points, sigma, "target");
+
+  // 2. The point sets 4PCS runs on: DoG keypoints (K-4PCS) or a coarser voxel grid (plain 4PCS).
+  std::vector<Eigen::Vector3f> source_set, target_set;
+  double delta = sigma;
+  if (params.method == CoarseMethod::kKeypoint4pcs) {
+    timer.run("keypoints", [&] {
+      const bool intensity = source.has_intensity() && target.has_intensity();
+      DogParams dog{sigma, params.octaves, params.scales_per_octave, params.min_contrast};
+      for (const auto* voxels : {&source_voxels, &target_voxels}) {
+        const SurfaceSignal signal = make_surface_signal(voxels->cloud, sigma, params.signal, intensity, cancel);
+        result.signal = signal.name;
+        auto& set = voxels == &source_voxels ? source_set : target_set;
+        set = detect_dog_keypoints(voxels->cloud.points, signal.values, dog, cancel).points;
+      }
+      return 0;
+    });
+    result.source_keypoints = source_set.size();
+    result.target_keypoints = target_set.size();
+    constexpr std::size_t kMinKeypoints = 8;
+    if (source_set.size() < kMinKeypoints || target_set.size() < kMinKeypoints)
+      fail(ErrorCode::kFailedPrecondition,
+           "too few keypoints (source " + std::to_string(source_set.size()) + ", target " +
+               std::to_string(target_set.size()) + "): try a smaller min_scale_m or check the clouds");
+  } else {
+    timer.run("plain_grid", [&] {
+      delta = params.plain_voxel_m > 0 ? params.plain_voxel_m : spacing_for_count(source_voxels.cloud, 4 * sigma, 2000);
+      source_set = voxel_grid(source_voxels.cloud, delta, cancel).cloud.points;
+      target_set = voxel_grid(target_voxels.cloud, delta, cancel).cloud.points;
+      return 0;
+    });
+    result.signal = "voxels";
+    result.source_keypoints = source_set.size();
+    result.target_keypoints = target_set.size();
+  }
+
+  // 3. 4PCS on the two point sets (paper Sec. 2.2).
+  const FourPcsResult matched = timer.run("matching", [&] {
+    FourPcsParams four{delta, params.overlap, params.max_bases, params.hypotheses_kept, params.seed};
+    return match_4pcs(source_set, target_set, four, cancel, progress);
+  });
+  result.bases_tried = matched.bases_tried;
+
+  // 4. Symmetry guard: settle each distinct hypothesis with a short coarse ICP and re-score it on the
+  //    voxelised clouds, where the furniture that breaks a room's symmetry is visible.
+  result.hypotheses = timer.run("symmetry_guard", [&] {
+    const double coarse = 2.0 * sigma;
+    PointCloud src_coarse = voxel_grid(source_voxels.cloud, coarse, cancel).cloud;
+    PointCloud tgt_coarse = voxel_grid(target_voxels.cloud, coarse, cancel).cloud;
+    const float tau = static_cast<float>(1.5 * coarse);
+    const NeighborGrid grid(tgt_coarse.points, tau);
+    std::vector<Hypothesis> hypotheses = matched.hypotheses;
+    for (Hypothesis& h : hypotheses) {
+      IcpParams quick{coarse, 2, 10};
+      h.transform = refine_icp(src_coarse.points, tgt_coarse.points, h.transform, quick, cancel).transform;
+      h.cloud_score = coverage(src_coarse.points, grid, h.transform, tau);
+    }
+    std::stable_sort(hypotheses.begin(), hypotheses.end(),
+                     [](const Hypothesis& a, const Hypothesis& b) { return a.cloud_score > b.cloud_score; });
+    // Hypotheses that ICP brought to the same pose are one hypothesis.
+    std::vector<Hypothesis> distinct;
+    for (const Hypothesis& h : hypotheses)
+      if (std::all_of(distinct.begin(), distinct.end(), [&](const Hypothesis& d) {
+            return distinct_transforms(d.transform, h.transform, 2.0, 2.0 * coarse);
+          }))
+        distinct.push_back(h);
+    return distinct;
+  });
+  const Hypothesis& best = result.hypotheses.front();
+  result.ambiguity_margin =
+      result.hypotheses.size() < 2 || best.cloud_score <= 0
+          ? 1.0
+          : (best.cloud_score - result.hypotheses[1].cloud_score) / best.cloud_score;
+
+  // 5. ICP refinement on the voxelised clouds (or just the quality figures with --no-icp).
+  const IcpResult refined = timer.run("icp", [&] {
+    IcpParams icp{sigma, params.icp ? 3 : 1, params.icp ? params.icp_max_iterations : 0};
+    return refine_icp(source_voxels.cloud.points, target_voxels.cloud.points, best.transform, icp, cancel);
+  });
+  const Eigen::Matrix4d local = params.icp ? refined.transform : best.transform;
+  result.icp_converged = params.icp && refined.converged;
+  result.icp_iterations = params.icp ? refined.iterations : 0;
+  result.rmse_m = refined.rmse_m;
+  result.overlap = refined.overlap;
+  result.inliers = refined.inliers;
+
+  result.transform = to_file_frames(local, source.origin_m, target.origin_m);
+  for (Hypothesis& h : result.hypotheses) h.transform = to_file_frames(h.transform, source.origin_m, target.origin_m);
+  return result;
+}
+
+}  // namespace
+
+RegistrationResult register_clouds(const PointCloud& source, const PointCloud& target, const RegistrationParams& params,
+                                   const CancellationToken* cancel, const ProgressCallback& progress) {
+  validate(params);
+  if (source.empty()) fail(ErrorCode::kInvalidArgument, "source cloud is empty");
+  if (target.empty()) fail(ErrorCode::kInvalidArgument, "target cloud is empty");
+  // A time budget becomes a deadline on a private token that also follows the caller's cancellation.
+  CancellationToken budget(cancel);
+  if (params.time_budget_s > 0)
+    budget.set_deadline(Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(params.time_budget_s)));
+  tbb::task_arena arena(params.threads > 0 ? params.threads : tbb::task_arena::automatic);
+  RegistrationResult result;
+  arena.execute([&] { result = run(source, target, params, &budget, progress); });
+  return result;
+}
+
+}  // namespace k4reg
