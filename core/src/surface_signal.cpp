@@ -3,6 +3,9 @@
 #include <Eigen/Eigenvalues>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "k4reg/error.h"
 #include "k4reg/neighbor_grid.h"
 
@@ -42,7 +45,13 @@ SurfaceSignal make_surface_signal(const PointCloud& voxels, double voxel_m, Keyp
   const bool intensity = requested == KeypointSignal::kIntensity || (requested == KeypointSignal::kAuto && use_intensity);
   if (intensity) {
     if (!voxels.has_intensity()) fail(ErrorCode::kInvalidArgument, "intensity signal requested but a cloud has no intensity");
-    return {voxels.intensity, "intensity"};
+    // Intensity is reflectance times an incidence and range falloff that differ between stations. In
+    // log space those smooth factors become additive and the DoG (a band-pass) cancels them.
+    std::vector<float> values(voxels.intensity.size());
+    const auto [lo, hi] = std::minmax_element(voxels.intensity.begin(), voxels.intensity.end());
+    const float floor = std::max(1e-6f, 1e-3f * (*hi - *lo));
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::log(std::max(voxels.intensity[i] - *lo, 0.0f) + floor);
+    return {std::move(values), "intensity"};
   }
   // Three voxels: enough neighbours (~28 on a plane) for a stable PCA, small enough to stay local.
   return {surface_variation(voxels.points, 3.0 * voxel_m, cancel), "geometric"};

@@ -1,4 +1,5 @@
-// 4x4 transforms as text: 4 rows of 4 numbers (the simulator's ground truth and `--out` files).
+// 4x4 rigid transforms as text: 4 rows of 4 numbers (the simulator's ground truth and `--out` files).
+// Reading accepts blank lines and '#' comments and requires a last row of 0 0 0 1.
 #pragma once
 
 #include <Eigen/Core>

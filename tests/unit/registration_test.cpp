@@ -1,0 +1,247 @@
+// End-to-end K-4PCS on real scans with ground truth: the Stanford bunny (no intensity, so the
+// geometric signal), survey-sized coordinates, determinism, cancellation and every error case.
+#include "k4reg/registration.h"
+
+#include <Eigen/LU>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <future>
+#include <random>
+#include <thread>
+
+#include "k4reg/cloud_io.h"
+#include "k4reg/error.h"
+#include "k4reg/gt_pairs.h"
+#include "k4reg/metrics.h"
+
+namespace k4reg {
+namespace {
+
+const std::string kBunny = std::string(K4REG_TEST_DATA_DIR) + "/bunny/";
+constexpr double kBunnyScale_m = 0.001;   // the bunny is 0.15 m across, sampled every ~0.7 mm
+constexpr double kBunnySuccess_m = 0.005; // true-correspondence RMSE: ~3 % of the object
+
+GtPair bunny_pair(const std::string& source, const std::string& target) {
+  for (const GtPair& p : read_gt_pairs(kBunny + "gt_pairs.log"))
+    if (p.source == source && p.target == target) return p;
+  throw std::runtime_error("no ground truth for " + source + " -> " + target);
+}
+
+
+ErrorCode error_code(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.code();
+  }
+  ADD_FAILURE() << "expected a k4reg::Error";
+  return ErrorCode::kInternal;
+}
+
+RegistrationParams bunny_params(double overlap) {
+  RegistrationParams p;
+  p.min_scale_m = kBunnyScale_m;
+  p.overlap = overlap;
+  return p;
+}
+
+TEST(Registration, BunnyTenHighestOverlapPairs) {
+  std::vector<GtPair> pairs = read_gt_pairs(kBunny + "gt_pairs.log");
+  std::stable_sort(pairs.begin(), pairs.end(), [](const GtPair& a, const GtPair& b) { return a.overlap > b.overlap; });
+  pairs.resize(10);
+  int successes = 0;
+  for (const GtPair& pair : pairs) {
+    const PointCloud source = read_cloud(kBunny + pair.source), target = read_cloud(kBunny + pair.target);
+    try {
+      const RegistrationResult r = register_clouds(source, target, bunny_params(pair.overlap));
+      const TransformError e = transform_error(source.points, r.transform, pair.T_target_source);
+      EXPECT_EQ(r.signal, "geometric");
+      successes += registration_succeeded(e, kBunnySuccess_m);
+      std::printf("%-14s -> %-10s overlap %.2f  rotation error %7.3f deg  RMSE %.5f m  margin %.2f\n",
+                  pair.source.c_str(), pair.target.c_str(), pair.overlap, e.rotation_deg, e.rmse_m, r.ambiguity_margin);
+    } catch (const Error& e) {
+      std::printf("%s -> %s: %s\n", pair.source.c_str(), pair.target.c_str(), e.what());
+    }
+  }
+  EXPECT_GE(successes, 8);
+}
+
+TEST(Registration, ResultCarriesTheEvidence) {
+  const GtPair pair = bunny_pair("bun045.ply", "bun000.ply");
+  const PointCloud source = read_cloud(kBunny + pair.source), target = read_cloud(kBunny + pair.target);
+  RegistrationParams params = bunny_params(0.9);
+  params.seed = 7;
+  const RegistrationResult r = register_clouds(source, target, params);
+  const TransformError e = transform_error(source.points, r.transform, pair.T_target_source);
+  EXPECT_LT(e.rmse_m, 0.001);  // after ICP: well under the 0.7 mm sampling
+  EXPECT_LT(r.rmse_m, 0.001);
+  EXPECT_GT(r.overlap, 0.7);
+  EXPECT_GT(r.inliers, 1000u);
+  EXPECT_EQ(r.source_points, source.size());
+  EXPECT_GT(r.source_keypoints, 20u);
+  EXPECT_GT(r.target_keypoints, 20u);
+  EXPECT_EQ(r.seed, 7u);
+  EXPECT_FALSE(r.hypotheses.empty());
+  EXPECT_GE(r.ambiguity_margin, 0.0);
+  EXPECT_LE(r.ambiguity_margin, 1.0);
+  std::vector<std::string> stages;
+  for (const StageTiming& t : r.timings) stages.push_back(t.stage);
+  EXPECT_EQ(stages, (std::vector<std::string>{"voxel_grid", "keypoints", "matching", "symmetry_guard", "icp"}));
+
+  params.icp = false;
+  const RegistrationResult coarse = register_clouds(source, target, params);
+  const TransformError ce = transform_error(source.points, coarse.transform, pair.T_target_source);
+  EXPECT_LT(ce.rmse_m, kBunnySuccess_m);  // the coarse result alone is inside ICP's basin
+  EXPECT_FALSE(coarse.icp_converged);
+}
+
+TEST(Registration, SameTransformForAnyThreadCount) {
+  const GtPair pair = bunny_pair("bun045.ply", "bun000.ply");
+  const PointCloud source = read_cloud(kBunny + pair.source), target = read_cloud(kBunny + pair.target);
+  RegistrationParams params = bunny_params(0.9);
+  params.threads = 1;
+  const RegistrationResult one = register_clouds(source, target, params);
+  params.threads = 2;
+  const RegistrationResult two = register_clouds(source, target, params);
+  params.threads = 3;  // more threads than cores
+  const RegistrationResult three = register_clouds(source, target, params);
+  EXPECT_EQ(one.transform, two.transform);  // bit-identical
+  EXPECT_EQ(one.transform, three.transform);
+  EXPECT_EQ(one.source_keypoints, two.source_keypoints);
+}
+
+TEST(Registration, TwoRegistrationsAtOnceInOneProcess) {
+  const GtPair pair = bunny_pair("bun045.ply", "bun000.ply");
+  const PointCloud source = read_cloud(kBunny + pair.source), target = read_cloud(kBunny + pair.target);
+  const RegistrationParams params = bunny_params(0.9);
+  const RegistrationResult alone = register_clouds(source, target, params);
+  auto a = std::async(std::launch::async, [&] { return register_clouds(source, target, params); });
+  auto b = std::async(std::launch::async, [&] { return register_clouds(source, target, params); });
+  EXPECT_EQ(a.get().transform, alone.transform);
+  EXPECT_EQ(b.get().transform, alone.transform);
+}
+
+TEST(Registration, SurveyCoordinatesRegisterAsPreciselyAsAtTheOrigin) {
+  const GtPair pair = bunny_pair("bun045.ply", "bun000.ply");
+  const PointCloud source = read_cloud(kBunny + pair.source), target = read_cloud(kBunny + pair.target);
+  // Both scans moved to UTM-sized coordinates, as double precision files would hold them.
+  const Eigen::Vector3d offset(512345.678, 5240123.456, 312.5);
+  PointCloud far_source = source, far_target = target;
+  far_source.origin_m += offset;
+  far_target.origin_m += offset;
+  const RegistrationResult near = register_clouds(source, target, bunny_params(0.9));
+  const RegistrationResult far = register_clouds(far_source, far_target, bunny_params(0.9));
+  // Truth in the far frames: shift back, apply, shift forward.
+  Eigen::Matrix4d shift = Eigen::Matrix4d::Identity();
+  shift.topRightCorner<3, 1>() = offset;
+  const Eigen::Matrix4d far_truth = shift * pair.T_target_source * shift.inverse();
+  EXPECT_LT((far.transform.topLeftCorner<3, 3>() - near.transform.topLeftCorner<3, 3>()).norm(), 1e-9);
+  Eigen::Matrix4d local_shift = Eigen::Matrix4d::Identity();  // metrics on the source's local points
+  local_shift.topRightCorner<3, 1>() = far_source.origin_m;
+  const TransformError e = transform_error(far_source.points, far.transform * local_shift, far_truth * local_shift);
+  const TransformError e0 = transform_error(source.points, near.transform, pair.T_target_source);
+  EXPECT_NEAR(e.rmse_m, e0.rmse_m, 1e-6);
+  EXPECT_LT(e.rmse_m, 0.001);
+}
+
+TEST(Registration, CancellationStopsWithin100ms) {
+  const GtPair pair = bunny_pair("bun045.ply", "bun000.ply");
+  const PointCloud source = read_cloud(kBunny + pair.source), target = read_cloud(kBunny + pair.target);
+  RegistrationParams params = bunny_params(0.9);
+  params.max_bases = 200000;  // minutes of work
+  CancellationToken token;
+  auto job = std::async(std::launch::async, [&] { return error_code([&] { register_clouds(source, target, params, &token); }); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const auto cancelled_at = std::chrono::steady_clock::now();
+  token.cancel();
+  EXPECT_EQ(job.get(), ErrorCode::kCancelled);
+  EXPECT_LT(std::chrono::steady_clock::now() - cancelled_at, std::chrono::milliseconds(100));
+}
+
+TEST(Registration, TimeBudgetGivesDeadlineExceeded) {
+  const GtPair pair = bunny_pair("bun045.ply", "bun000.ply");
+  const PointCloud source = read_cloud(kBunny + pair.source), target = read_cloud(kBunny + pair.target);
+  RegistrationParams params = bunny_params(0.9);
+  params.max_bases = 200000;
+  params.time_budget_s = 0.3;
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(error_code([&] { register_clouds(source, target, params); }), ErrorCode::kDeadlineExceeded);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(400));
+}
+
+TEST(Registration, ProgressReportsEveryStage) {
+  const PointCloud source = read_cloud(kBunny + "bun045.ply"), target = read_cloud(kBunny + "bun000.ply");
+  std::vector<std::string> started;
+  register_clouds(source, target, bunny_params(0.9), nullptr, [&](const std::string& stage, double fraction) {
+    if (fraction == 0.0) started.push_back(stage);
+  });
+  EXPECT_EQ(started, (std::vector<std::string>{"voxel_grid", "keypoints", "matching", "symmetry_guard", "icp"}));
+}
+
+PointCloud grid_cloud(int nx, int ny, int nz, float step) {
+  PointCloud cloud;
+  for (int x = 0; x < nx; ++x)
+    for (int y = 0; y < ny; ++y)
+      for (int z = 0; z < nz; ++z) cloud.points.emplace_back(x * step, y * step, z * step);
+  return cloud;
+}
+
+TEST(Registration, ClearErrors) {
+  const PointCloud bunny = read_cloud(kBunny + "bun000.ply");
+  const RegistrationParams ok = bunny_params(0.9);
+  EXPECT_EQ(error_code([&] { register_clouds(PointCloud{}, bunny, ok); }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(error_code([&] { register_clouds(bunny, PointCloud{}, ok); }), ErrorCode::kInvalidArgument);
+  for (double scale : {0.0, -1.0, 1e-6, 100.0, double(NAN)}) {
+    RegistrationParams p = ok;
+    p.min_scale_m = scale;
+    EXPECT_EQ(error_code([&] { register_clouds(bunny, bunny, p); }), ErrorCode::kInvalidArgument) << scale;
+  }
+  for (double overlap : {0.0, 1.5, -0.2, double(NAN)}) {
+    RegistrationParams p = ok;
+    p.overlap = overlap;
+    EXPECT_EQ(error_code([&] { register_clouds(bunny, bunny, p); }), ErrorCode::kInvalidArgument) << overlap;
+  }
+  // Degenerate geometry: a plane and a line.
+  const PointCloud plane = grid_cloud(100, 100, 1, 0.01f), line = grid_cloud(1000, 1, 1, 0.01f);
+  EXPECT_EQ(error_code([&] { register_clouds(plane, plane, bunny_params(0.9)); }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(error_code([&] { register_clouds(line, bunny, bunny_params(0.9)); }), ErrorCode::kInvalidArgument);
+  // A featureless box: a few uniform voxels give no DoG extrema.
+  const PointCloud box = grid_cloud(4, 4, 4, 0.01f);
+  EXPECT_EQ(error_code([&] { register_clouds(box, bunny, bunny_params(0.9)); }), ErrorCode::kFailedPrecondition);
+  // Intensity requested for clouds without it.
+  RegistrationParams intensity = ok;
+  intensity.signal = KeypointSignal::kIntensity;
+  EXPECT_EQ(error_code([&] { register_clouds(bunny, bunny, intensity); }), ErrorCode::kInvalidArgument);
+}
+
+TEST(Registration, NoHypothesisIsFailedPrecondition) {
+  // Keypoints exist, but a bunny scan and a random cloud share no congruent 4-point sets.
+  const PointCloud bunny = read_cloud(kBunny + "bun000.ply");
+  PointCloud noise;
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> u(-0.07f, 0.07f);
+  for (int i = 0; i < 30000; ++i) noise.points.emplace_back(u(rng), u(rng), u(rng));
+  RegistrationParams p = bunny_params(0.9);
+  p.max_bases = 10;
+  const ErrorCode code = error_code([&] { register_clouds(bunny, noise, p); });
+  EXPECT_EQ(code, ErrorCode::kFailedPrecondition);
+}
+
+TEST(Registration, PlainFourPcsBaselineIsSelectable) {
+  const GtPair pair = bunny_pair("bun045.ply", "bun000.ply");
+  const PointCloud source = read_cloud(kBunny + pair.source), target = read_cloud(kBunny + pair.target);
+  RegistrationParams params = bunny_params(0.9);
+  params.method = CoarseMethod::kPlain4pcs;
+  params.plain_voxel_m = 0.008;
+  const RegistrationResult r = register_clouds(source, target, params);
+  EXPECT_EQ(r.signal, "voxels");
+  EXPECT_GT(r.source_keypoints, 100u);  // the coarse grid's points
+  const TransformError e = transform_error(source.points, r.transform, pair.T_target_source);
+  EXPECT_LT(e.rmse_m, kBunnySuccess_m);
+}
+
+}  // namespace
+}  // namespace k4reg
