@@ -17,7 +17,8 @@ namespace k4reg {
 namespace {
 
 constexpr int kBatch = 8;               // bases per parallel batch (fixed: determinism)
-constexpr int kPrescreenPoints = 40;    // cheap first look before a full verification
+constexpr int kPrescreenPoints = 40;   // cheap first look before a full verification
+constexpr std::size_t kMaxSetsPerBase = 20000;
 constexpr double kInlierFactor = 3.0;   // inlier distance in units of delta
 
 // Robust extent of a cloud: the diagonal of the 2nd..98th percentile box, blind to a few far outliers.
@@ -35,12 +36,13 @@ double robust_diameter(const std::vector<Eigen::Vector3f>& points) {
   return extent.norm();
 }
 
-// MSAC-style score: each point contributes 1 - d^2/tau^2 when within tau of a target point.
+// MSAC-style score: each point contributes 1 - d^2/tau^2 when within tau of a target point, and -1
+// when it lands in the target scanner's observed free space.
 class Verifier {
  public:
   Verifier(const std::vector<Eigen::Vector3f>& source, const std::vector<Eigen::Vector3f>& target, double tau_m,
-           int max_points, std::uint64_t seed)
-      : grid_(target, 2.0 * tau_m), tau_(static_cast<float>(tau_m)) {  // 8-cell look-ups
+           int max_points, std::uint64_t seed, const FreeSpaceImage* free_space)
+      : grid_(target, 2.0 * tau_m), tau_(static_cast<float>(tau_m)), free_space_(free_space) {  // 8-cell look-ups
     std::vector<std::uint32_t> order(source.size());
     std::iota(order.begin(), order.end(), 0);
     std::mt19937_64 rng(seed);
@@ -58,7 +60,11 @@ class Verifier {
     double s = 0;
     for (std::size_t k = 0; k < count; ++k) {
       float d2 = 0;
-      if (grid_.nearest_within(a * points_[k], tau_, &d2) >= 0) s += 1.0 - d2 * inv_tau2;
+      const Eigen::Vector3f q = a * points_[k];
+      if (grid_.nearest_within(q, tau_, &d2) >= 0)
+        s += 1.0 - d2 * inv_tau2;
+      else if (free_space_ && free_space_->contradicts(q))
+        s -= 1.0;
       if (s + static_cast<double>(count - k - 1) < beat) return -1.0;
     }
     return s;
@@ -67,15 +73,42 @@ class Verifier {
  private:
   NeighborGrid grid_;
   float tau_;
+  const FreeSpaceImage* free_space_;
   std::vector<Eigen::Vector3f> points_;
 };
 
-struct BaseOutcome {
-  bool found = false;
-  double score = -1;
+struct Candidate {
+  double score = 0;
   Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();
-  std::size_t sets = 0;
 };
+
+// The best few distinct candidates of one base. A base of a symmetric scene matches both the true
+// pose and its mirror image; keeping only the best would let the mirror crowd the truth out.
+struct BaseOutcome {
+  static constexpr std::size_t kKept = 3;
+  std::vector<Candidate> candidates;  // best first
+  std::size_t sets = 0;
+
+  // Score a newcomer must beat to matter.
+  double floor() const { return candidates.size() < kKept ? 0.0 : candidates.back().score; }
+
+  void offer(const Candidate& c, double min_angle_deg, double min_translation_m) {
+    auto same = std::find_if(candidates.begin(), candidates.end(), [&](const Candidate& k) {
+      return !distinct_transforms(k.transform, c.transform, min_angle_deg, min_translation_m);
+    });
+    if (same != candidates.end()) {
+      if (c.score <= same->score) return;
+      candidates.erase(same);
+    }
+    candidates.insert(std::upper_bound(candidates.begin(), candidates.end(), c,
+                                       [](const Candidate& a, const Candidate& b) { return a.score > b.score; }),
+                      c);
+    if (candidates.size() > kKept) candidates.pop_back();
+  }
+};
+
+constexpr double kDistinctAngle_deg = 10.0;
+constexpr double kDistinctShiftDeltas = 10.0;
 
 }  // namespace
 
@@ -103,7 +136,8 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
   const double max_width = std::max(params.overlap * robust_diameter(source), 10.0 * params.delta_m);
   const double min_width = std::max(0.1 * max_width, 4.0 * params.delta_m);
   const PairIndex pairs(target, min_width - tolerance.pair_m, max_width + tolerance.pair_m);
-  const Verifier verifier(source, target, kInlierFactor * params.delta_m, params.verification_points, params.seed);
+  const Verifier verifier(source, target, kInlierFactor * params.delta_m, params.verification_points, params.seed,
+                         params.target_free_space);
   const int bases = params.max_bases > 0 ? params.max_bases : bases_for_overlap(params.overlap);
 
   std::vector<BaseOutcome> outcomes(bases);
@@ -120,6 +154,13 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
       find_congruent_sets(base, target, pairs, tolerance, sets);
       BaseOutcome& out = outcomes[b];
       out.sets = sets.size();
+      // Dense, regular point sets (the plain-4PCS baseline on a grid) give combinatorially many sets;
+      // an even subsample keeps a base's cost bounded.
+      if (sets.size() > kMaxSetsPerBase) {
+        const std::size_t stride = (sets.size() + kMaxSetsPerBase - 1) / kMaxSetsPerBase;
+        for (std::size_t k = 0; k * stride < sets.size(); ++k) sets[k] = sets[k * stride];
+        sets.resize((sets.size() + stride - 1) / stride);
+      }
       Eigen::Matrix3Xd from(3, 4), to(3, 4);
       for (int k = 0; k < 4; ++k) from.col(k) = base.point[k].cast<double>();
       const double prescreen_fraction = std::min(1.0, double(kPrescreenPoints) / verifier.size());
@@ -128,37 +169,39 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
         for (int k = 0; k < 4; ++k) to.col(k) = target[sets[s][k]].cast<double>();
         const Eigen::Matrix4d t = fit_rigid(from, to);
         if (fit_rms(t, from, to) > tolerance.fit_rms_m) continue;
-        const double beat = std::max(out.score, global_best);
+        const double beat = std::max(out.floor(), global_best);
         // Prescreen on the first points: a hypothesis far below the best so far is not worth a full look.
         const std::size_t few = std::min<std::size_t>(kPrescreenPoints, verifier.size());
         const double partial = verifier.score(t, few, 0.0);
         if (partial / prescreen_fraction < 0.5 * beat) continue;
-        const double full = verifier.score(t, verifier.size(), std::max(out.score, 0.5 * global_best));
-        if (full > out.score) out.found = true, out.score = full, out.transform = t;
+        const double full = verifier.score(t, verifier.size(), std::max(out.floor(), 0.5 * global_best));
+        if (full > out.floor() && full > 0)
+          out.offer({full, t}, kDistinctAngle_deg, kDistinctShiftDeltas * params.delta_m);
       }
     });
-    for (int b = start; b < end; ++b) global_best = std::max(global_best, outcomes[b].score);
+    for (int b = start; b < end; ++b)
+      if (!outcomes[b].candidates.empty()) global_best = std::max(global_best, outcomes[b].candidates.front().score);
     if (progress) progress("matching", double(end) / bases);
   }
 
-  // Distinct hypotheses, best first (ties to the earlier base, so the order is deterministic).
-  std::vector<int> order;
+  // Distinct hypotheses over all bases, best first (ties to the earlier base: deterministic order).
+  std::vector<Candidate> all;
   FourPcsResult result;
   result.bases_tried = bases;
-  for (int b = 0; b < bases; ++b) {
-    result.congruent_sets += outcomes[b].sets;
-    if (outcomes[b].found) order.push_back(b);
+  for (const BaseOutcome& outcome : outcomes) {
+    result.congruent_sets += outcome.sets;
+    all.insert(all.end(), outcome.candidates.begin(), outcome.candidates.end());
   }
-  std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return outcomes[x].score > outcomes[y].score; });
-  for (int b : order) {
+  std::stable_sort(all.begin(), all.end(), [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  for (const Candidate& c : all) {
     if (static_cast<int>(result.hypotheses.size()) >= params.hypotheses_kept) break;
     const bool is_new = std::all_of(result.hypotheses.begin(), result.hypotheses.end(), [&](const Hypothesis& h) {
-      return distinct_transforms(h.transform, outcomes[b].transform, 10.0, 10.0 * params.delta_m);
+      return distinct_transforms(h.transform, c.transform, kDistinctAngle_deg, kDistinctShiftDeltas * params.delta_m);
     });
     if (!is_new) continue;
     Hypothesis h;
-    h.transform = outcomes[b].transform;
-    h.keypoint_score = outcomes[b].score / verifier.size();
+    h.transform = c.transform;
+    h.keypoint_score = c.score / verifier.size();
     result.hypotheses.push_back(h);
   }
   if (result.hypotheses.empty())

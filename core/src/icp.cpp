@@ -89,23 +89,38 @@ std::vector<Eigen::Vector3f> estimate_normals(const std::vector<Eigen::Vector3f>
   return normals;
 }
 
-IcpResult refine_icp(const std::vector<Eigen::Vector3f>& source, const std::vector<Eigen::Vector3f>& target,
-                     const Eigen::Matrix4d& initial, const IcpParams& params, const CancellationToken* cancel) {
+IcpPyramid make_icp_pyramid(const std::vector<Eigen::Vector3f>& points, const IcpParams& params, bool as_target,
+                            const CancellationToken* cancel) {
+  IcpPyramid pyramid;
+  pyramid.stages.resize(params.stages);  // final addresses first: a grid refers to its stage's points
+  for (int stage = 0; stage < params.stages; ++stage) {
+    check(cancel);
+    IcpPyramid::Stage& s = pyramid.stages[stage];
+    s.voxel_m = params.voxel_m * std::pow(2.0, params.stages - 1 - stage);
+    s.points = stage == params.stages - 1 ? points : downsample(points, s.voxel_m);
+    if (as_target) {
+      s.normals = estimate_normals(s.points, 2.5 * s.voxel_m);
+      s.grid = std::make_unique<NeighborGrid>(s.points, params.max_distance_factor * s.voxel_m);
+    }
+  }
+  return pyramid;
+}
+
+IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const Eigen::Matrix4d& initial,
+                     const IcpParams& params, const CancellationToken* cancel) {
   IcpResult result;
   result.transform = initial;
-  for (int stage = 0; stage < params.stages; ++stage) {
-    const double voxel = params.voxel_m * std::pow(2.0, params.stages - 1 - stage);
-    const bool finest = stage == params.stages - 1;
-    const std::vector<Eigen::Vector3f> src = finest ? source : downsample(source, voxel);
-    const std::vector<Eigen::Vector3f> tgt = finest ? target : downsample(target, voxel);
-    const std::vector<Eigen::Vector3f> normals = estimate_normals(tgt, 2.5 * voxel);
+  const std::size_t stages = std::min(source.stages.size(), target.stages.size());
+  for (std::size_t stage = 0; stage < stages; ++stage) {
+    const auto& src = source.stages[stage];
+    const auto& tgt = target.stages[stage];
+    const double voxel = tgt.voxel_m;
     const float max_distance = static_cast<float>(params.max_distance_factor * voxel);
-    const NeighborGrid grid(tgt, max_distance);
     result.converged = false;
-    Accumulation acc;
     for (int it = 0; it < params.max_iterations; ++it) {
       check(cancel);
-      acc = accumulate(src, tgt, normals, grid, to_affine3f(result.transform), max_distance, voxel);
+      const Accumulation acc =
+          accumulate(src.points, tgt.points, tgt.normals, *tgt.grid, to_affine3f(result.transform), max_distance, voxel);
       ++result.iterations;
       if (acc.inliers < 6) break;
       const Eigen::Matrix<double, 6, 1> delta = acc.hessian.ldlt().solve(-acc.gradient);
@@ -120,11 +135,12 @@ IcpResult refine_icp(const std::vector<Eigen::Vector3f>& source, const std::vect
         break;
       }
     }
-    if (finest) {
-      acc = accumulate(src, tgt, normals, grid, to_affine3f(result.transform), max_distance, voxel);
+    if (stage + 1 == stages) {
+      const Accumulation acc =
+          accumulate(src.points, tgt.points, tgt.normals, *tgt.grid, to_affine3f(result.transform), max_distance, voxel);
       result.inliers = acc.inliers;
       result.rmse_m = acc.inliers ? std::sqrt(acc.squared_residuals / acc.inliers) : 0.0;
-      result.overlap = src.empty() ? 0.0 : double(acc.inliers) / src.size();
+      result.overlap = src.points.empty() ? 0.0 : double(acc.inliers) / src.points.size();
     }
   }
   return result;

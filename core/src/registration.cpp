@@ -6,14 +6,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "k4reg/dog_keypoints.h"
 #include "k4reg/error.h"
 #include "k4reg/four_pcs.h"
+#include "k4reg/free_space.h"
 #include "k4reg/icp.h"
 #include "k4reg/neighbor_grid.h"
 #include "k4reg/rigid_fit.h"
 #include "k4reg/surface_signal.h"
+#include "k4reg/symmetry_guard.h"
 #include "k4reg/voxel_grid.h"
 
 namespace k4reg {
@@ -39,6 +42,8 @@ class StageTimer {
   const ProgressCallback& progress_;
 };
 
+}  // namespace
+
 void validate(const RegistrationParams& p) {
   auto bad = [](const std::string& what) { fail(ErrorCode::kInvalidArgument, what); };
   if (!(p.min_scale_m >= 0.001 && p.min_scale_m <= 10.0)) bad("min_scale_m must be in [0.001, 10] m");
@@ -53,6 +58,8 @@ void validate(const RegistrationParams& p) {
   if (!(p.time_budget_s >= 0.0) || !std::isfinite(p.time_budget_s)) bad("time_budget_s must be >= 0");
   if (!(p.plain_voxel_m >= 0.0 && p.plain_voxel_m <= 100.0)) bad("plain_voxel_m must be in [0, 100] m");
 }
+
+namespace {
 
 // Refuses clouds that cannot define a rigid transform: empty, a single point, a line or a plane.
 void check_geometry(const std::vector<Eigen::Vector3f>& points, double scale_m, const char* name) {
@@ -74,13 +81,16 @@ void check_geometry(const std::vector<Eigen::Vector3f>& points, double scale_m, 
     fail(ErrorCode::kInvalidArgument, std::string(name) + " cloud is degenerate: all points lie on a plane");
 }
 
-// Share of source points with a target point within tau after t.
-double coverage(const std::vector<Eigen::Vector3f>& source, const NeighborGrid& target_grid, const Eigen::Matrix4d& t,
-                float tau) {
-  const Eigen::Affine3f a = to_affine3f(t);
-  std::size_t hits = 0;
-  for (const auto& p : source) hits += target_grid.any_within(a * p, tau);
-  return source.empty() ? 0.0 : double(hits) / source.size();
+// The scanner sits at the file frame's origin, i.e. at -origin_m in the cloud's local frame.
+Eigen::Vector3f scanner_position(const PointCloud& cloud) { return (-cloud.origin_m).cast<float>(); }
+
+bool use_free_space(FreeSpaceCheck check, const VoxelizedCloud& source, const VoxelizedCloud& target) {
+  if (check != FreeSpaceCheck::kAuto) return check == FreeSpaceCheck::kOn;
+  // Terrestrial scans surround their scanner at metres; object scans (whose origin may sit inside the
+  // object) have no meaningful free space around the frame origin.
+  constexpr double kMinScannerRange_m = 1.0;
+  return FreeSpaceImage::median_range_m(source.cloud.points, scanner_position(source.cloud)) >= kMinScannerRange_m &&
+         FreeSpaceImage::median_range_m(target.cloud.points, scanner_position(target.cloud)) >= kMinScannerRange_m;
 }
 
 // The voxel spacing at which a cloud keeps about `points` voxels (the paper's plain-4PCS baseline).
@@ -118,7 +128,9 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
 
   // 2. The point sets 4PCS runs on: DoG keypoints (K-4PCS) or a coarser voxel grid (plain 4PCS).
   std::vector<Eigen::Vector3f> source_set, target_set;
-  double delta = sigma;
+  // Keypoint precision: repeated keypoints of two scans lie within about 2 sigma of each other
+  // (measured on the simulated lab and the bunny), so every 4PCS tolerance derives from 2 sigma.
+  double delta = 2.0 * sigma;
   if (params.method == CoarseMethod::kKeypoint4pcs) {
     timer.run("keypoints", [&] {
       const bool intensity = source.has_intensity() && target.has_intensity();
@@ -150,7 +162,11 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
     result.target_keypoints = target_set.size();
   }
 
-  // 3. 4PCS on the two point sets (paper Sec. 2.2).
+  // 3. 4PCS on the two point sets (paper Sec. 2.2), scored with the target's free space when known.
+  result.free_space_used = use_free_space(params.free_space, source_voxels, target_voxels);
+  std::optional<FreeSpaceImage> free_space;
+  if (result.free_space_used)
+    free_space.emplace(target.points, scanner_position(target), 3.0 * delta);  // raw points fill every cell
   const FourPcsResult matched = timer.run("matching", [&] {
     FourPcsParams four{delta, params.overlap, params.max_bases, params.hypotheses_kept, params.seed};
     return match_4pcs(source_set, target_set, four, cancel, progress);
@@ -159,39 +175,26 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
 
   // 4. Symmetry guard: settle each distinct hypothesis with a short coarse ICP and re-score it on the
   //    voxelised clouds, where the furniture that breaks a room's symmetry is visible.
-  result.hypotheses = timer.run("symmetry_guard", [&] {
-    const double coarse = 2.0 * sigma;
-    PointCloud src_coarse = voxel_grid(source_voxels.cloud, coarse, cancel).cloud;
-    PointCloud tgt_coarse = voxel_grid(target_voxels.cloud, coarse, cancel).cloud;
-    const float tau = static_cast<float>(1.5 * coarse);
-    const NeighborGrid grid(tgt_coarse.points, tau);
-    std::vector<Hypothesis> hypotheses = matched.hypotheses;
-    for (Hypothesis& h : hypotheses) {
-      IcpParams quick{coarse, 2, 10};
-      h.transform = refine_icp(src_coarse.points, tgt_coarse.points, h.transform, quick, cancel).transform;
-      h.cloud_score = coverage(src_coarse.points, grid, h.transform, tau);
-    }
-    std::stable_sort(hypotheses.begin(), hypotheses.end(),
-                     [](const Hypothesis& a, const Hypothesis& b) { return a.cloud_score > b.cloud_score; });
-    // Hypotheses that ICP brought to the same pose are one hypothesis.
-    std::vector<Hypothesis> distinct;
-    for (const Hypothesis& h : hypotheses)
-      if (std::all_of(distinct.begin(), distinct.end(), [&](const Hypothesis& d) {
-            return distinct_transforms(d.transform, h.transform, 2.0, 2.0 * coarse);
-          }))
-        distinct.push_back(h);
-    return distinct;
+  IcpParams icp_params;
+  icp_params.voxel_m = sigma;
+  icp_params.max_iterations = params.icp_max_iterations;
+  const auto [source_pyramid, target_pyramid] = timer.run("icp_setup", [&] {
+    return std::make_pair(make_icp_pyramid(source_voxels.cloud.points, icp_params, false, cancel),
+                          make_icp_pyramid(target_voxels.cloud.points, icp_params, true, cancel));
   });
+  const SymmetryGuardResult guarded = timer.run("symmetry_guard", [&] {
+    return rank_hypotheses(source_pyramid, target_pyramid, matched.hypotheses, free_space ? &*free_space : nullptr,
+                           cancel);
+  });
+  result.hypotheses = guarded.hypotheses;
+  result.ambiguity_margin = guarded.ambiguity_margin;
   const Hypothesis& best = result.hypotheses.front();
-  result.ambiguity_margin =
-      result.hypotheses.size() < 2 || best.cloud_score <= 0
-          ? 1.0
-          : (best.cloud_score - result.hypotheses[1].cloud_score) / best.cloud_score;
 
   // 5. ICP refinement on the voxelised clouds (or just the quality figures with --no-icp).
   const IcpResult refined = timer.run("icp", [&] {
-    IcpParams icp{sigma, params.icp ? 3 : 1, params.icp ? params.icp_max_iterations : 0};
-    return refine_icp(source_voxels.cloud.points, target_voxels.cloud.points, best.transform, icp, cancel);
+    IcpParams final_params = icp_params;
+    if (!params.icp) final_params.max_iterations = 0;  // quality figures only, at the finest stage
+    return refine_icp(source_pyramid, target_pyramid, best.transform, final_params, cancel);
   });
   const Eigen::Matrix4d local = params.icp ? refined.transform : best.transform;
   result.icp_converged = params.icp && refined.converged;

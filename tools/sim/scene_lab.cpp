@@ -83,19 +83,22 @@ void add_desk(std::vector<Primitive>& out, double x, double y, double yaw, bool 
 }
 
 void add_furniture(std::vector<Primitive>& out) {
+  // Furniture is where the room's half-turn symmetry breaks, as in a real lab: desks mostly in the
+  // west half, cabinets along the north wall only.
   add_desk(out, 2.6, 5.5, 0.0, true);
   add_desk(out, 2.6, 6.9, 0.0, false);
   add_desk(out, 5.6, 8.6, 0.0, true);
-  add_desk(out, 9.0, 1.3, 0.0, true);
+  add_desk(out, 5.2, 2.2, std::numbers::pi / 2, true);
   add_desk(out, 10.5, 2.6, 0.0, false);  // station 3's scanner stands on this one
-  add_desk(out, 13.0, 5.0, std::numbers::pi / 2, true);
+  add_desk(out, 13.0, 6.2, std::numbers::pi / 2, true);
 
   // Cabinets with door gaps (vertical dark lines on every face).
   const Surface cabinet = paint(stripes(0.55, 0.1, 0.5, 0.012));
   out.push_back(box_between(Vector3d(0.0, 7.0, 0.0), Vector3d(0.5, 8.0, 2.0), cabinet));
   out.push_back(box_between(Vector3d(4.8, 9.5, 0.0), Vector3d(5.8, 10.0, 2.0), cabinet));
   out.push_back(box_between(Vector3d(5.8, 9.6, 0.0), Vector3d(6.5, 10.0, 0.9), paint(uniform(0.35))));
-  out.push_back(box_between(Vector3d(14.5, 2.0, 0.0), Vector3d(15.0, 3.0, 2.0), cabinet));
+  out.push_back(box_between(Vector3d(7.6, 9.5, 0.0), Vector3d(8.6, 10.0, 2.0), cabinet));
+  out.push_back(box_between(Vector3d(14.55, 0.3, 0.0), Vector3d(15.0, 1.9, 1.1), cabinet));  // a low sideboard
 
   // Whiteboards in dark frames on the short walls (at half-turn symmetric places, different contents).
   const Surface frame = paint(uniform(0.2));

@@ -1,5 +1,5 @@
-// Fixed-radius neighbour search on a hashed grid whose cells are as large as the search radius:
-// a query visits the 27 cells around it. For the near-uniform voxelised clouds of this pipeline this
+// Fixed-radius neighbour search on a hashed grid whose cells are about as large as the search radius:
+// a query visits the (at most 27) cells its ball touches. For the near-uniform voxelised clouds of this pipeline this
 // is several times faster than a k-d tree. Cost: O(n) to build; O(neighbours) per query.
 #pragma once
 
@@ -37,7 +37,7 @@ class NeighborGrid {
         }
   }
 
-  // Index of the nearest point within radius_m of q, or -1; squared distance in *d2.
+  // Index of the nearest point within radius_m (<= cell_m) of q, or -1; squared distance in *d2.
   int nearest_within(const Eigen::Vector3f& q, float radius_m, float* d2 = nullptr) const {
     int best = -1;
     float best_d2 = std::numeric_limits<float>::max();

@@ -25,6 +25,12 @@ enum class KeypointSignal {
   kGeometric,   // DoG of the surface variation from local PCA (clouds without intensity)
 };
 
+enum class FreeSpaceCheck {
+  kAuto,  // on when both scans look like terrestrial scans taken from their frame's origin
+  kOn,
+  kOff,
+};
+
 struct RegistrationParams {
   // The two parameters that matter (paper Tab. 1).
   double min_scale_m = 0.05;  // minimum DoG scale sigma; also the voxel grid spacing
@@ -41,6 +47,9 @@ struct RegistrationParams {
   double plain_voxel_m = 0.0;  // voxel spacing for kPlain4pcs; 0 = chosen to give ~ as many points as keypoints
   int max_bases = 0;           // number of 4-point bases L; 0 = from the overlap
   int hypotheses_kept = 5;     // distinct hypotheses re-scored by the symmetry guard
+  // Penalise hypotheses that put source points where the target scanner (at the target file's origin)
+  // saw empty space: breaks the 180-degree flips of symmetric rooms.
+  FreeSpaceCheck free_space = FreeSpaceCheck::kAuto;
 
   // ICP refinement.
   bool icp = true;
@@ -71,6 +80,7 @@ struct RegistrationResult {
   std::size_t source_voxels = 0, target_voxels = 0;
   std::size_t source_keypoints = 0, target_keypoints = 0;
   std::string signal;           // "intensity" or "geometric" (or "voxels" for plain 4PCS)
+  bool free_space_used = false;
   double ambiguity_margin = 0.0;  // (best - runner-up) / best cloud score; small = ambiguous (e.g. symmetry)
   std::vector<Hypothesis> hypotheses;  // best first
   int bases_tried = 0;
@@ -79,6 +89,9 @@ struct RegistrationResult {
   int icp_iterations = 0;
   std::vector<StageTiming> timings;
 };
+
+// Throws kInvalidArgument naming the first parameter out of range.
+void validate(const RegistrationParams& params);
 
 // Registers source onto target. Throws k4reg::Error: kInvalidArgument for empty/degenerate clouds or
 // parameters out of range, kFailedPrecondition when too few keypoints or no hypothesis is found,

@@ -1,0 +1,143 @@
+// k4reg-server: the k4reg.v1.Registration gRPC service (see proto/k4reg/v1/registration.proto), with
+// grpc.health.v1 health and server reflection. Configuration: server_config.h (flags or K4REG_* variables).
+//
+// SIGTERM / SIGINT drain: readiness goes NOT_SERVING, new calls get UNAVAILABLE, queued and running jobs
+// get --drain-grace-s to finish, then the rest are cancelled; the process exits 0.
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <signal.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "health.h"
+#include "json_log.h"
+#include "registration_service.h"
+#include "server_config.h"
+
+namespace k4reg::service {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string read_text_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+std::shared_ptr<grpc::ServerCredentials> credentials(const ServerConfig& config) {
+  if (config.tls_cert.empty()) return grpc::InsecureServerCredentials();
+  grpc::SslServerCredentialsOptions options;
+  options.pem_key_cert_pairs.push_back({read_text_file(config.tls_key), read_text_file(config.tls_cert)});
+  return grpc::SslServerCredentials(options);
+}
+
+int milliseconds(double seconds) { return static_cast<int>(std::min(seconds * 1000.0, 2.0e9)); }
+
+void set_connection_options(grpc::ServerBuilder& builder, const ServerConfig& config) {
+  builder.SetMaxReceiveMessageSize(static_cast<int>((config.max_inline_mb << 20) + (64 << 10)));
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, milliseconds(config.keepalive_time_s));
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, 20'000);
+  // Clients waiting minutes for a job may ping to keep NATs and proxies open; allow it every 10 s.
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+  builder.AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS, 10'000);
+  if (config.max_connection_age_s > 0) {
+    // GOAWAY after the age (+-10 % jitter): clients reconnect and spread over the current replicas.
+    builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_MS, milliseconds(config.max_connection_age_s));
+    builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_AGE_GRACE_MS, milliseconds(config.max_connection_age_grace_s));
+  }
+}
+
+// Written via a temporary name, so a reader never sees a partial number.
+void write_port_file(const std::string& path, int port) {
+  const std::string temporary = path + ".tmp";
+  std::ofstream(temporary) << port << "\n";
+  std::filesystem::rename(temporary, path);
+}
+
+int serve(const ServerConfig& config, const sigset_t& stop_signals) {
+  log_json(spdlog::level::info, "starting", {{"version", K4REG_VERSION}, {"config", config_to_json(config)}});
+  const PathPolicy paths(config.data_roots);
+  SpoolDir spool(config.spool_dir);
+  MemoryBudget memory(config.memory_budget_mb << 20);
+  JobQueue queue(config.workers, config.queue_size);
+  v1::ServerInfo info;
+  info.set_version(K4REG_VERSION);
+  info.set_server_id(config.server_id);
+  RegistrationService service(ServiceContext{queue, memory, paths, spool, JobLimits{config.max_points, config.job_threads},
+                                             config.auth_token, std::uint64_t(config.max_upload_mb) << 20, info});
+
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  grpc::ServerBuilder builder;
+  int port = 0;
+  builder.AddListeningPort(config.grpc_listen, credentials(config), &port);
+  builder.RegisterService(&service);
+  set_connection_options(builder, config);
+  const std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+  if (!server || port == 0) {
+    log_json(spdlog::level::critical, "cannot listen", {{"grpc_listen", config.grpc_listen}});
+    return 1;
+  }
+  HealthPublisher health(*server->GetHealthCheckService(), queue);
+  queue.set_on_change([&health] { health.update(); });
+  health.update();  // changes before the line above
+  if (!config.port_file.empty()) write_port_file(config.port_file, port);
+  log_json(spdlog::level::info, "serving", {{"grpc_port", port}, {"server_id", config.server_id}});
+
+  int signal_number = 0;
+  sigwait(&stop_signals, &signal_number);
+  log_json(spdlog::level::info, "draining", {{"signal", signal_number}, {"queued", queue.waiting()}, {"running", queue.running()}});
+  health.set_draining();
+  queue.stop_accepting();
+  const auto grace = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(config.drain_grace_s));
+  if (!queue.wait_idle(Clock::now() + grace)) {
+    log_json(spdlog::level::warn, "drain grace period over, cancelling jobs",
+             {{"queued", queue.waiting()}, {"running", queue.running()}});
+    queue.cancel_all();
+    queue.wait_idle(Clock::now() + std::chrono::seconds(10));  // cancellation takes effect within ~100 ms
+  }
+  // Replies already handed to gRPC get this long to leave; calls without a job (an unfinished upload) are
+  // cut. Idle client connections that ignore GOAWAY also hold Shutdown until the deadline.
+  server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
+  queue.stop();
+  log_json(spdlog::level::info, "stopped");
+  return 0;
+}
+
+}  // namespace
+}  // namespace k4reg::service
+
+int main(int argc, char** argv) {
+  // Before any thread exists: every thread inherits the blocked mask, so the signals reach only the
+  // sigwait() in serve() — no work in a signal handler.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGTERM);
+  sigaddset(&stop_signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+
+  CLI::App app{"k4reg-server: markerless laser-scan registration (K-4PCS) as a gRPC service"};
+  k4reg::service::ServerConfig config;
+  k4reg::service::add_config_options(app, config);
+  try {
+    app.parse(argc, argv);
+    k4reg::service::finish_config(config);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  k4reg::service::init_json_logging(config.log_level);
+  try {
+    return k4reg::service::serve(config, stop_signals);
+  } catch (const std::exception& e) {
+    k4reg::service::log_json(spdlog::level::critical, "fatal", {{"error", e.what()}});
+    return 1;
+  }
+}

@@ -1,0 +1,126 @@
+#include "proto_convert.h"
+
+#include <string>
+
+#include "k4reg/error.h"
+
+namespace k4reg::service {
+namespace {
+
+KeypointSignal signal_from_proto(v1::KeypointSignal signal) {
+  switch (signal) {
+    case v1::KEYPOINT_SIGNAL_UNSPECIFIED:
+      return RegistrationParams{}.signal;
+    case v1::KEYPOINT_SIGNAL_AUTO:
+      return KeypointSignal::kAuto;
+    case v1::KEYPOINT_SIGNAL_INTENSITY:
+      return KeypointSignal::kIntensity;
+    case v1::KEYPOINT_SIGNAL_GEOMETRIC:
+      return KeypointSignal::kGeometric;
+    default:
+      fail(ErrorCode::kInvalidArgument, "params.signal: unknown value " + std::to_string(signal));
+  }
+}
+
+CoarseMethod method_from_proto(v1::CoarseMethod method) {
+  switch (method) {
+    case v1::COARSE_METHOD_UNSPECIFIED:
+      return RegistrationParams{}.method;
+    case v1::COARSE_METHOD_KEYPOINT_4PCS:
+      return CoarseMethod::kKeypoint4pcs;
+    case v1::COARSE_METHOD_PLAIN_4PCS:
+      return CoarseMethod::kPlain4pcs;
+    default:
+      fail(ErrorCode::kInvalidArgument, "params.method: unknown value " + std::to_string(method));
+  }
+}
+
+// The core owns the valid ranges; checking them here refuses bad parameters before a job is queued or
+// an upload accepted.
+void check_ranges(const RegistrationParams& params) {
+  try {
+    validate(params);
+  } catch (const Error& e) {
+    fail(e.code(), std::string("params.") + e.what());
+  }
+}
+
+}  // namespace
+
+FreeSpaceCheck free_space_from_proto(v1::FreeSpaceCheck check) {
+  switch (check) {
+    case v1::FREE_SPACE_CHECK_UNSPECIFIED:
+      return RegistrationParams{}.free_space;
+    case v1::FREE_SPACE_CHECK_AUTO:
+      return FreeSpaceCheck::kAuto;
+    case v1::FREE_SPACE_CHECK_ON:
+      return FreeSpaceCheck::kOn;
+    case v1::FREE_SPACE_CHECK_OFF:
+      return FreeSpaceCheck::kOff;
+    default:
+      fail(ErrorCode::kInvalidArgument, "params.free_space: unknown value " + std::to_string(check));
+  }
+}
+
+RegistrationParams params_from_proto(const v1::RegistrationParams& m) {
+  RegistrationParams p;
+  if (m.has_min_scale_m()) p.min_scale_m = m.min_scale_m();
+  if (m.has_overlap()) p.overlap = m.overlap();
+  if (m.has_octaves()) p.octaves = m.octaves();
+  if (m.has_scales_per_octave()) p.scales_per_octave = m.scales_per_octave();
+  if (m.has_min_contrast()) p.min_contrast = m.min_contrast();
+  p.signal = signal_from_proto(m.signal());
+  p.method = method_from_proto(m.method());
+  if (m.has_plain_voxel_m()) p.plain_voxel_m = m.plain_voxel_m();
+  if (m.has_max_bases()) p.max_bases = m.max_bases();
+  if (m.has_hypotheses_kept()) p.hypotheses_kept = m.hypotheses_kept();
+  if (m.has_icp()) p.icp = m.icp();
+  if (m.has_icp_max_iterations()) p.icp_max_iterations = m.icp_max_iterations();
+  if (m.has_seed()) p.seed = m.seed();
+  if (m.has_threads()) p.threads = m.threads();
+  if (m.has_time_budget_s()) p.time_budget_s = m.time_budget_s();
+  p.free_space = free_space_from_proto(m.free_space());
+  check_ranges(p);
+  return p;
+}
+
+void matrix_to_proto(const Eigen::Matrix4d& matrix, google::protobuf::RepeatedField<double>* values) {
+  values->Clear();
+  values->Reserve(16);
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) values->Add(matrix(r, c));
+}
+
+void result_to_proto(const RegistrationResult& r, v1::RegistrationResult* m) {
+  matrix_to_proto(r.transform, m->mutable_transform());
+  m->set_rmse_m(r.rmse_m);
+  m->set_overlap(r.overlap);
+  m->set_inliers(r.inliers);
+  m->set_source_points(r.source_points);
+  m->set_target_points(r.target_points);
+  m->set_source_voxels(r.source_voxels);
+  m->set_target_voxels(r.target_voxels);
+  m->set_source_keypoints(r.source_keypoints);
+  m->set_target_keypoints(r.target_keypoints);
+  m->set_signal(r.signal);
+  m->set_ambiguity_margin(r.ambiguity_margin);
+  m->clear_hypotheses();
+  for (const Hypothesis& h : r.hypotheses) {
+    v1::Hypothesis* out = m->add_hypotheses();
+    matrix_to_proto(h.transform, out->mutable_transform());
+    out->set_keypoint_score(h.keypoint_score);
+    out->set_cloud_score(h.cloud_score);
+  }
+  m->set_bases_tried(r.bases_tried);
+  m->set_seed(r.seed);
+  m->set_icp_converged(r.icp_converged);
+  m->set_icp_iterations(r.icp_iterations);
+  m->clear_timings();
+  for (const StageTiming& t : r.timings) {
+    v1::StageTiming* out = m->add_timings();
+    out->set_stage(t.stage);
+    out->set_seconds(t.seconds);
+  }
+}
+
+}  // namespace k4reg::service

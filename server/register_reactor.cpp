@@ -1,0 +1,83 @@
+#include "register_reactor.h"
+
+#include "k4reg/error.h"
+#include "proto_convert.h"
+#include "status_mapping.h"
+
+namespace k4reg::service {
+
+RegisterReactor::RegisterReactor(ServiceContext& service, grpc::CallbackServerContext* context,
+                                 const v1::RegisterRequest* request, v1::RegisterResponse* reply)
+    : service_(service), reply_(reply) {
+  record_ = open_request(*context, "/k4reg.v1.Registration/Register");
+  if (const grpc::Status status = service_.admit(*context); !status.ok()) {
+    finish(status);
+    return;
+  }
+  try {
+    params_ = params_from_proto(request->params());
+    source_ = cloud_source(request->source(), "source");
+    target_ = cloud_source(request->target(), "target");
+  } catch (...) {
+    finish(status_from_current_exception());
+    return;
+  }
+  job_ = std::make_shared<Job>([this](Job& job) { execute(job); });
+  apply_deadline(*context, job_->token());
+  clock_.enqueued = CallClock::Clock::now();
+  std::size_t position = 0;
+  // From here on a worker may already be running the job: touch nothing it uses.
+  if (const grpc::Status status = service_.submit(job_, position); !status.ok()) finish(status);
+}
+
+CloudSource RegisterReactor::cloud_source(const v1::CloudInput& input, const char* role) const {
+  switch (input.kind_case()) {
+    case v1::CloudInput::kPath:
+      return service_.referenced_cloud(input.path());
+    case v1::CloudInput::kInlineCloud: {
+      const v1::InlineCloud& cloud = input.inline_cloud();
+      return {cloud.file_name().empty() ? role : cloud.file_name(), {}, cloud.data()};
+    }
+    case v1::CloudInput::KIND_NOT_SET:
+      break;
+  }
+  fail(ErrorCode::kInvalidArgument, std::string(role) + ": give either path or inline_cloud");
+}
+
+void RegisterReactor::execute(Job& job) {
+  clock_.job_start = CallClock::Clock::now();
+  JobReport report;
+  grpc::Status status;
+  try {
+    const RegistrationResult result =
+        run_registration(source_, target_, params_, service_.limits, service_.memory, job.token(), {}, report);
+    result_to_proto(result, reply_->mutable_result());
+  } catch (...) {
+    status = status_from_current_exception();
+  }
+  clock_.job_end = CallClock::Clock::now();
+  record_.source_points = report.source_points;
+  record_.target_points = report.target_points;
+  record_.queue_wait_s = std::chrono::duration<double>(clock_.job_start - clock_.enqueued).count();
+  record_.registration_s = report.registration_s;
+  if (status.ok()) decorate_reply(service_, clock_, report, record_.request_id, *reply_);
+  finish(status);
+}
+
+void RegisterReactor::OnCancel() {
+  if (!job_) return;  // refused before queueing; already finished
+  job_->token().cancel();
+  if (service_.queue.withdraw(job_.get())) finish({grpc::StatusCode::CANCELLED, "cancelled while queued"});
+}
+
+void RegisterReactor::finish(const grpc::Status& status) {
+  if (finished_.exchange(true)) return;
+  record_.code = status.error_code();
+  record_.error = status.error_message();
+  log_request(record_);  // before the reply leaves: a client that got its answer finds the log line
+  Finish(status);
+}
+
+void RegisterReactor::OnDone() { delete this; }
+
+}  // namespace k4reg::service

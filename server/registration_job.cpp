@@ -1,0 +1,86 @@
+#include "registration_job.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "k4reg/cloud_io.h"
+#include "k4reg/error.h"
+
+namespace k4reg::service {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+// Reader messages start with the path they were given; clients should see their own name instead of a
+// server path (data root or spool file).
+PointCloud load(const CloudSource& source, const ReadOptions& options) {
+  try {
+    if (source.file.empty()) return read_cloud_bytes(source.bytes, source.name, options);
+    return read_cloud(source.file, options);
+  } catch (const Error& e) {
+    std::string message = e.what();
+    if (!source.file.empty() && message.rfind(source.file, 0) == 0)
+      message = source.name + message.substr(source.file.size());
+    if (e.code() == ErrorCode::kResourceExhausted) message += " (--max-points)";
+    throw Error(e.code(), message);
+  }
+}
+
+// The core reports (stage, fraction) with 0 at a stage's start and 1 at its end (a stage may report 1
+// twice); listeners get explicit phases.
+class StageTracker {
+ public:
+  explicit StageTracker(const StageListener& listener) : listener_(listener) {}
+  void operator()(const std::string& stage, double fraction) {
+    if (!listener_) return;
+    if (stage != stage_) {
+      stage_ = stage;
+      finished_ = false;
+      listener_(stage, v1::StageEvent::PHASE_STARTED, 0.0);
+      if (fraction <= 0.0) return;
+    }
+    if (finished_) return;
+    finished_ = fraction >= 1.0;
+    listener_(stage, finished_ ? v1::StageEvent::PHASE_FINISHED : v1::StageEvent::PHASE_PROGRESS,
+              std::clamp(fraction, 0.0, 1.0));
+  }
+
+ private:
+  const StageListener& listener_;
+  std::string stage_;
+  bool finished_ = false;
+};
+
+}  // namespace
+
+RegistrationResult run_registration(const CloudSource& source, const CloudSource& target, RegistrationParams params,
+                                    const JobLimits& limits, MemoryBudget& memory, const CancellationToken& token,
+                                    const StageListener& listener, JobReport& report) {
+  token.throw_if_stopped();  // cancelled or expired while queued
+  StageTracker progress(listener);
+
+  const auto load_start = Clock::now();
+  progress("load", 0.0);
+  const ReadOptions options{limits.max_points};
+  const PointCloud source_cloud = load(source, options);
+  report.source_points = source_cloud.size();
+  token.throw_if_stopped();
+  const PointCloud target_cloud = load(target, options);
+  report.target_points = target_cloud.size();
+  progress("load", 1.0);
+  report.load_s = seconds_since(load_start);
+
+  const MemoryBudget::Reservation reservation =
+      memory.reserve(kBytesPerPoint * (source_cloud.size() + target_cloud.size()), token);
+
+  if (params.threads == 0 || params.threads > limits.job_threads) params.threads = limits.job_threads;
+  const auto start = Clock::now();
+  const ProgressCallback callback = [&](const std::string& stage, double fraction) { progress(stage, fraction); };
+  RegistrationResult result = register_clouds(source_cloud, target_cloud, params, &token, callback);
+  report.registration_s = seconds_since(start);
+  return result;
+}
+
+}  // namespace k4reg::service

@@ -1,0 +1,43 @@
+// What a worker does for one request, whatever RPC it came from: load both clouds, reserve their memory,
+// run the core. Shared by the unary and the streaming reactor (and the HTTP API later).
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <string_view>
+
+#include "k4reg/cancellation.h"
+#include "k4reg/registration.h"
+#include "k4reg/v1/registration.pb.h"
+#include "memory_budget.h"
+
+namespace k4reg::service {
+
+// A cloud as the worker reads it: a file (a resolved data-root path or a spool file) or inline bytes.
+struct CloudSource {
+  std::string name;        // as the client named it: used in messages and as the format hint
+  std::string file;        // empty = read `bytes`
+  std::string_view bytes;  // owned by the request, which outlives the job
+};
+
+struct JobLimits {
+  std::size_t max_points = 0;  // per cloud, 0 = unlimited
+  int job_threads = 1;         // core threads per job; the request may ask for fewer
+};
+
+// Filled as the job goes, so that a failed job still reports what it got to.
+struct JobReport {
+  std::uint64_t source_points = 0, target_points = 0;
+  double load_s = 0, registration_s = 0;
+};
+
+// Stage events for progress streams: "load", then the core's stages. Called on the worker thread.
+using StageListener = std::function<void(const std::string& stage, v1::StageEvent::Phase phase, double fraction)>;
+
+// Throws k4reg::Error (kCancelled / kDeadlineExceeded once the token fires).
+RegistrationResult run_registration(const CloudSource& source, const CloudSource& target, RegistrationParams params,
+                                    const JobLimits& limits, MemoryBudget& memory, const CancellationToken& token,
+                                    const StageListener& listener, JobReport& report);
+
+}  // namespace k4reg::service

@@ -1,0 +1,87 @@
+#include "request_log.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <random>
+
+#include "json_log.h"
+
+namespace k4reg::service {
+namespace {
+
+std::string new_uuid() {
+  thread_local std::mt19937_64 random{std::random_device{}()};
+  const std::uint64_t hi = (random() & 0xFFFFFFFFFFFF0FFFull) | 0x4000ull;                 // version 4
+  const std::uint64_t lo = (random() & 0x3FFFFFFFFFFFFFFFull) | 0x8000000000000000ull;    // variant 10
+  return fmt::format("{:08x}-{:04x}-{:04x}-{:04x}-{:012x}", hi >> 32, (hi >> 16) & 0xFFFF, hi & 0xFFFF, lo >> 48,
+                     lo & 0xFFFFFFFFFFFFull);
+}
+
+
+const char* status_code_name(grpc::StatusCode code) {
+  switch (code) {
+    case grpc::StatusCode::OK: return "OK";
+    case grpc::StatusCode::CANCELLED: return "CANCELLED";
+    case grpc::StatusCode::UNKNOWN: return "UNKNOWN";
+    case grpc::StatusCode::INVALID_ARGUMENT: return "INVALID_ARGUMENT";
+    case grpc::StatusCode::DEADLINE_EXCEEDED: return "DEADLINE_EXCEEDED";
+    case grpc::StatusCode::NOT_FOUND: return "NOT_FOUND";
+    case grpc::StatusCode::ALREADY_EXISTS: return "ALREADY_EXISTS";
+    case grpc::StatusCode::PERMISSION_DENIED: return "PERMISSION_DENIED";
+    case grpc::StatusCode::UNAUTHENTICATED: return "UNAUTHENTICATED";
+    case grpc::StatusCode::RESOURCE_EXHAUSTED: return "RESOURCE_EXHAUSTED";
+    case grpc::StatusCode::FAILED_PRECONDITION: return "FAILED_PRECONDITION";
+    case grpc::StatusCode::ABORTED: return "ABORTED";
+    case grpc::StatusCode::OUT_OF_RANGE: return "OUT_OF_RANGE";
+    case grpc::StatusCode::UNIMPLEMENTED: return "UNIMPLEMENTED";
+    case grpc::StatusCode::INTERNAL: return "INTERNAL";
+    case grpc::StatusCode::UNAVAILABLE: return "UNAVAILABLE";
+    case grpc::StatusCode::DATA_LOSS: return "DATA_LOSS";
+    default: return "UNKNOWN";
+  }
+}
+
+}  // namespace
+
+std::string request_id_of(const grpc::ServerContextBase& context) {
+  const auto& metadata = context.client_metadata();
+  const auto it = metadata.find("x-request-id");
+  if (it != metadata.end()) {
+    const std::string id(it->second.data(), it->second.size());
+    if (!id.empty() && id.size() <= 128 &&
+        std::all_of(id.begin(), id.end(), [](char c) { return c > 0x20 && c < 0x7F && c != '"' && c != '\\'; }))
+      return id;
+  }
+  return new_uuid();
+}
+
+RequestRecord open_request(grpc::CallbackServerContext& context, const char* method) {
+  RequestRecord record;
+  record.method = method;
+  record.request_id = request_id_of(context);
+  record.peer = context.peer();
+  context.AddInitialMetadata("x-request-id", record.request_id);
+  return record;
+}
+
+void log_request(const RequestRecord& r) {
+  const double duration_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r.start).count();
+  nlohmann::json fields{{"request_id", r.request_id},
+                        {"method", r.method},
+                        {"peer", r.peer},
+                        {"code", status_code_name(r.code)},
+                        {"duration_ms", duration_ms},
+                        {"source_points", r.source_points},
+                        {"target_points", r.target_points},
+                        {"queue_wait_ms", 1000.0 * r.queue_wait_s},
+                        {"registration_ms", 1000.0 * r.registration_s}};
+  if (r.upload_bytes) fields["upload_bytes"] = r.upload_bytes;
+  if (r.code != grpc::StatusCode::OK) fields["error"] = r.error;
+  // Client mistakes and overload are expected traffic; only server faults are warnings.
+  const bool fault = r.code == grpc::StatusCode::INTERNAL || r.code == grpc::StatusCode::UNKNOWN;
+  log_json(fault ? spdlog::level::warn : spdlog::level::info, "request", std::move(fields));
+}
+
+}  // namespace k4reg::service

@@ -1,0 +1,119 @@
+#include "server_config.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <thread>
+
+namespace k4reg::service {
+
+void add_config_options(CLI::App& app, ServerConfig& c) {
+  app.add_option("--grpc-listen", c.grpc_listen, "gRPC address host:port (port 0 = ephemeral)")
+      ->envname("K4REG_GRPC_LISTEN")
+      ->capture_default_str();
+  app.add_option("--http-listen", c.http_listen, "HTTP/JSON address (reserved; not served yet)")
+      ->envname("K4REG_HTTP_LISTEN");
+  app.add_option("--port-file", c.port_file, "write the bound gRPC port to this file once serving")
+      ->envname("K4REG_PORT_FILE");
+  app.add_option("--data-root", c.data_roots, "folder whose files requests may reference (repeatable; env: colon-separated)")
+      ->envname("K4REG_DATA_ROOT")
+      ->delimiter(':')
+      ->check(CLI::ExistingDirectory);
+  app.add_option("--workers", c.workers, "concurrent jobs, 0 = number of cores")->envname("K4REG_WORKERS");
+  app.add_option("--queue-size", c.queue_size, "jobs that may wait for a worker; beyond: RESOURCE_EXHAUSTED")
+      ->envname("K4REG_QUEUE_SIZE")
+      ->capture_default_str();
+  app.add_option("--job-threads", c.job_threads, "core threads per job (caps the request's params.threads)")
+      ->envname("K4REG_JOB_THREADS")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1024));
+  app.add_option("--max-points", c.max_points, "points per cloud, 0 = unlimited")
+      ->envname("K4REG_MAX_POINTS")
+      ->capture_default_str();
+  app.add_option("--memory-budget-mb", c.memory_budget_mb,
+                 "estimated memory of all running jobs (60 bytes per input point), 0 = half the RAM")
+      ->envname("K4REG_MEMORY_BUDGET_MB");
+  app.add_option("--spool-dir", c.spool_dir, "parent folder of the upload spool (default: system temp)")
+      ->envname("K4REG_SPOOL_DIR");
+  app.add_option("--drain-grace-s", c.drain_grace_s, "on SIGTERM, seconds running jobs may take before cancellation")
+      ->envname("K4REG_DRAIN_GRACE_S")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--auth-token", c.auth_token, "require 'authorization: Bearer TOKEN' (health stays open)")
+      ->envname("K4REG_AUTH_TOKEN");
+  auto* cert = app.add_option("--tls-cert", c.tls_cert, "PEM certificate chain (enables TLS)")
+                   ->envname("K4REG_TLS_CERT")
+                   ->check(CLI::ExistingFile);
+  auto* key = app.add_option("--tls-key", c.tls_key, "PEM private key")->envname("K4REG_TLS_KEY")->check(CLI::ExistingFile);
+  cert->needs(key);
+  key->needs(cert);
+  app.add_option("--max-upload-mb", c.max_upload_mb, "largest streamed file, MiB")
+      ->envname("K4REG_MAX_UPLOAD_MB")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--max-inline-mb", c.max_inline_mb, "largest unary request (inline clouds), MiB")
+      ->envname("K4REG_MAX_INLINE_MB")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1024));
+  app.add_option("--max-connection-age-s", c.max_connection_age_s,
+                 "close connections after about this long so clients rebalance across replicas, 0 = never")
+      ->envname("K4REG_MAX_CONNECTION_AGE_S")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--max-connection-age-grace-s", c.max_connection_age_grace_s,
+                 "time calls on an aged connection get to finish (longer than the longest job)")
+      ->envname("K4REG_MAX_CONNECTION_AGE_GRACE_S")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--keepalive-time-s", c.keepalive_time_s, "ping idle connections this often")
+      ->envname("K4REG_KEEPALIVE_TIME_S")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--server-id", c.server_id, "replica name returned in every response (default host:pid)")
+      ->envname("K4REG_SERVER_ID");
+  app.add_option("--log-level", c.log_level, "trace, debug, info, warn, error, critical, off")
+      ->envname("K4REG_LOG_LEVEL")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+}
+
+void finish_config(ServerConfig& c) {
+  if (c.workers == 0) c.workers = std::max(1u, std::thread::hardware_concurrency());
+  if (c.memory_budget_mb == 0) {
+    const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
+    c.memory_budget_mb = pages > 0 && page_size > 0 ? std::size_t(pages) * std::size_t(page_size) / 2 / (1 << 20) : 4096;
+  }
+  if (c.spool_dir.empty()) c.spool_dir = std::filesystem::temp_directory_path().string();
+  if (c.server_id.empty()) {
+    char host[256] = {};
+    gethostname(host, sizeof host - 1);
+    c.server_id = std::string(host) + ":" + std::to_string(getpid());
+  }
+  if (c.queue_size == 0) throw CLI::ValidationError("--queue-size", "must be at least 1");
+}
+
+nlohmann::json config_to_json(const ServerConfig& c) {
+  return {{"grpc_listen", c.grpc_listen},
+          {"http_listen", c.http_listen},
+          {"port_file", c.port_file},
+          {"data_roots", c.data_roots},
+          {"workers", c.workers},
+          {"queue_size", c.queue_size},
+          {"job_threads", c.job_threads},
+          {"max_points", c.max_points},
+          {"memory_budget_mb", c.memory_budget_mb},
+          {"spool_dir", c.spool_dir},
+          {"drain_grace_s", c.drain_grace_s},
+          {"auth", !c.auth_token.empty()},
+          {"tls", !c.tls_cert.empty()},
+          {"max_upload_mb", c.max_upload_mb},
+          {"max_inline_mb", c.max_inline_mb},
+          {"max_connection_age_s", c.max_connection_age_s},
+          {"max_connection_age_grace_s", c.max_connection_age_grace_s},
+          {"keepalive_time_s", c.keepalive_time_s},
+          {"server_id", c.server_id},
+          {"log_level", c.log_level}};
+}
+
+}  // namespace k4reg::service

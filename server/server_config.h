@@ -1,0 +1,43 @@
+// Server configuration: command-line flags, each with an environment-variable equivalent (K4REG_*),
+// so containers can be configured either way. A flag given on the command line wins over the variable.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cstddef>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace k4reg::service {
+
+struct ServerConfig {
+  std::string grpc_listen = "0.0.0.0:50051";  // port 0 = ephemeral (logged and written to port_file)
+  std::string http_listen;                    // reserved for the HTTP/JSON API (not served yet)
+  std::string port_file;                      // where to write the bound gRPC port, if set
+  std::vector<std::string> data_roots;        // referenced files must lie under one of these
+  std::size_t workers = 0;                    // 0 = number of cores
+  std::size_t queue_size = 16;                // waiting jobs beyond the running ones
+  int job_threads = 1;                        // core threads per job; parallelism comes from the workers
+  std::size_t max_points = 50'000'000;        // per cloud; 0 = unlimited
+  std::size_t memory_budget_mb = 0;           // for all running jobs; 0 = half the physical memory
+  std::string spool_dir;                      // parent of the per-process upload directory; "" = system temp
+  double drain_grace_s = 25.0;                // after SIGTERM, running jobs get this long before cancellation
+  std::string auth_token;                     // if set, calls need "authorization: Bearer <token>"
+  std::string tls_cert, tls_key;              // PEM files; both or neither
+  std::size_t max_upload_mb = 4096;           // per streamed file
+  std::size_t max_inline_mb = 32;             // per unary request (inline clouds), gRPC message limit
+  double max_connection_age_s = 0;            // 0 = unlimited; otherwise GOAWAY after ~this long (rebalancing)
+  double max_connection_age_grace_s = 600;    // calls in flight on an aged connection get this long to end
+  double keepalive_time_s = 60;               // server pings idle connections this often
+  std::string server_id;                      // "" = host:pid
+  std::string log_level = "info";
+};
+
+void add_config_options(CLI::App& app, ServerConfig& config);
+// Fills the derived defaults (workers, memory budget, spool dir, server id) and checks combinations.
+// Throws CLI::ValidationError.
+void finish_config(ServerConfig& config);
+// For the start-up log line: everything except the token's value.
+nlohmann::json config_to_json(const ServerConfig& config);
+
+}  // namespace k4reg::service

@@ -1,0 +1,278 @@
+#include "test_support.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "crc32c.h"
+#include "grpc/health/v1/health.grpc.pb.h"
+#include "k4reg/gt_pairs.h"
+
+extern char** environ;
+
+namespace k4reg::test {
+
+fs::path bunny_dir() { return fs::path(K4REG_TEST_DATA_DIR) / "bunny"; }
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read " + path.string());
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
+void write_file(const fs::path& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+TempDir::TempDir() {
+  std::string pattern = (fs::temp_directory_path() / "k4reg-test-XXXXXX").string();
+  if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+  path_ = pattern;
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+}
+
+ServerProcess::ServerProcess(const std::vector<std::string>& args, const std::map<std::string, std::string>& env) {
+  const fs::path port_file = work_.path() / "port", log_file = work_.path() / "server.log";
+  std::vector<std::string> arguments{K4REG_BIN_DIR "/k4reg-server", "--grpc-listen", "127.0.0.1:0",
+                                     "--port-file", port_file.string(), "--spool-dir", (work_.path() / "spool").string()};
+  arguments.insert(arguments.end(), args.begin(), args.end());
+  // The caller's K4REG_* variables must not leak into the server under test.
+  std::vector<std::string> environment;
+  for (char** e = environ; *e; ++e)
+    if (std::string_view(*e).rfind("K4REG_", 0) != 0) environment.emplace_back(*e);
+  for (const auto& [name, value] : env) environment.push_back(name + "=" + value);
+
+  std::vector<char*> argv, envp;
+  for (std::string& a : arguments) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  for (std::string& e : environment) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  const int log_fd = ::open(log_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  pid_ = fork();
+  if (pid_ == 0) {
+    dup2(log_fd, STDERR_FILENO);
+    execve(argv[0], argv.data(), envp.data());
+    _exit(127);
+  }
+  ::close(log_fd);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!fs::exists(port_file)) {
+    int status = 0;
+    if (waitpid(pid_, &status, WNOHANG) == pid_) {
+      exited_ = true;
+      throw std::runtime_error("k4reg-server exited at start-up: " + log());
+    }
+    if (std::chrono::steady_clock::now() > deadline) throw std::runtime_error("k4reg-server did not start: " + log());
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  port_ = std::stoi(read_file(port_file));
+}
+
+ServerProcess::~ServerProcess() {
+  if (exited_ || pid_ <= 0) return;
+  kill(pid_, SIGKILL);
+  waitpid(pid_, nullptr, 0);
+}
+
+std::shared_ptr<grpc::Channel> ServerProcess::channel() const {
+  return grpc::CreateChannel(address(), grpc::InsecureChannelCredentials());
+}
+
+std::unique_ptr<v1::Registration::Stub> ServerProcess::stub() const { return v1::Registration::NewStub(channel()); }
+
+std::size_t ServerProcess::spooled_files() const {
+  std::size_t count = 0;
+  std::error_code ec;
+  for (const auto& entry : fs::recursive_directory_iterator(work_.path() / "spool", ec))
+    count += entry.is_regular_file();
+  return count;
+}
+
+std::string ServerProcess::log() const { return read_file(work_.path() / "server.log"); }
+
+std::vector<nlohmann::json> ServerProcess::log_lines(const std::string& msg) const {
+  std::vector<nlohmann::json> lines;
+  std::istringstream text(log());
+  for (std::string line; std::getline(text, line);) {
+    nlohmann::json json = nlohmann::json::parse(line, nullptr, false);
+    if (!json.is_discarded() && json.value("msg", "") == msg) lines.push_back(std::move(json));
+  }
+  return lines;
+}
+
+void ServerProcess::signal(int number) const { kill(pid_, number); }
+
+int ServerProcess::wait(std::chrono::seconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    int status = 0;
+    if (waitpid(pid_, &status, WNOHANG) == pid_) {
+      exited_ = true;
+      return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    }
+    if (std::chrono::steady_clock::now() > deadline) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+      exited_ = true;
+      throw std::runtime_error("k4reg-server did not exit in time");
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
+v1::RegistrationParams bunny_params() {
+  v1::RegistrationParams params;
+  params.set_min_scale_m(0.001);
+  params.set_overlap(0.9);
+  return params;
+}
+
+v1::RegistrationParams slow_params(double seconds) {
+  // Measured on this project's 2-core machine: ~1 s of keypoints/ICP plus ~0.16 ms per 4PCS base.
+  v1::RegistrationParams params = bunny_params();
+  params.set_max_bases(static_cast<int>(std::clamp((seconds - 1.0) / 0.16e-3, 1000.0, 1e6)));
+  return params;
+}
+
+v1::RegistrationParams quick_params() {
+  v1::RegistrationParams params;
+  params.set_min_scale_m(0.004);
+  params.set_overlap(0.9);
+  return params;
+}
+
+v1::RegisterRequest bunny_request(const v1::RegistrationParams& params) {
+  v1::RegisterRequest request;
+  request.mutable_source()->set_path("bun045.ply");
+  request.mutable_target()->set_path("bun000.ply");
+  *request.mutable_params() = params;
+  return request;
+}
+
+std::string sphere_xyz() {
+  std::ostringstream text;
+  constexpr int kPoints = 4000;
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < kPoints; ++i) {
+    const double y = 1.0 - 2.0 * (i + 0.5) / kPoints, r = std::sqrt(1.0 - y * y), t = golden * i;
+    text << r * std::cos(t) << ' ' << y << ' ' << r * std::sin(t) << '\n';
+  }
+  return text.str();
+}
+
+Eigen::Matrix4d to_matrix(const google::protobuf::RepeatedField<double>& values) {
+  if (values.size() != 16) throw std::runtime_error("a transform needs 16 values");
+  Eigen::Matrix4d m;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) m(r, c) = values.Get(4 * r + c);
+  return m;
+}
+
+Eigen::Matrix4d bunny_truth(const std::string& source, const std::string& target) {
+  for (const GtPair& pair : read_gt_pairs((bunny_dir() / "gt_pairs.log").string()))
+    if (pair.source == source && pair.target == target) return pair.T_target_source;
+  throw std::runtime_error("no ground truth for " + source + " -> " + target);
+}
+
+v1::UploadHeader upload_header(const std::string& source_name, const std::string& source_bytes,
+                               const std::string& target_name, const std::string& target_bytes,
+                               const v1::RegistrationParams& params) {
+  v1::UploadHeader header;
+  auto describe = [](v1::UploadedFile* file, const std::string& name, const std::string& bytes) {
+    file->set_file_name(name);
+    file->set_size_bytes(bytes.size());
+    file->set_crc32c(crc32c(bytes));
+  };
+  describe(header.mutable_source()->mutable_upload(), source_name, source_bytes);
+  describe(header.mutable_target()->mutable_upload(), target_name, target_bytes);
+  *header.mutable_params() = params;
+  return header;
+}
+
+StreamCall::StreamCall(v1::Registration::Stub& stub, grpc::ClientContext& context, const v1::UploadHeader& header,
+                       const StreamUpload& upload)
+    : stream_(stub.RegisterStream(&context)) {
+  v1::RegisterStreamRequest message;
+  *message.mutable_header() = header;
+  bool open = stream_->Write(message);
+  auto send = [&](v1::CloudRole role, const std::string& bytes) {
+    for (std::size_t offset = 0; open && offset < bytes.size(); offset += upload.chunk_bytes) {
+      v1::RegisterStreamRequest chunk;
+      chunk.mutable_chunk()->set_role(role);
+      chunk.mutable_chunk()->set_data(bytes.substr(offset, upload.chunk_bytes));
+      open = stream_->Write(chunk);
+    }
+  };
+  if (header.source().has_upload()) send(v1::CLOUD_ROLE_SOURCE, upload.source_bytes);
+  if (header.target().has_upload()) send(v1::CLOUD_ROLE_TARGET, upload.target_bytes);
+  stream_->WritesDone();
+}
+
+bool StreamCall::next() {
+  v1::RegisterStreamResponse event;
+  if (!stream_->Read(&event)) return false;
+  events_.push_back(std::move(event));
+  return true;
+}
+
+bool StreamCall::wait_for_queued() {
+  while (next())
+    if (events_.back().has_queued()) return true;
+  return false;
+}
+
+bool StreamCall::wait_for_stage(const std::string& stage, v1::StageEvent::Phase phase) {
+  while (next())
+    if (events_.back().has_stage() && events_.back().stage().stage() == stage && events_.back().stage().phase() == phase)
+      return true;
+  return false;
+}
+
+grpc::Status StreamCall::finish() {
+  while (next()) {
+  }
+  return stream_->Finish();
+}
+
+const v1::RegisterResponse* StreamCall::result() const {
+  return !events_.empty() && events_.back().has_result() ? &events_.back().result() : nullptr;
+}
+
+std::string health_status(const ServerProcess& server, const std::string& service) {
+  auto stub = grpc::health::v1::Health::NewStub(server.channel());
+  grpc::ClientContext context;
+  set_timeout(context, std::chrono::seconds(10));
+  grpc::health::v1::HealthCheckRequest request;
+  request.set_service(service);
+  grpc::health::v1::HealthCheckResponse reply;
+  const grpc::Status status = stub->Check(&context, request, &reply);
+  if (!status.ok()) return std::to_string(status.error_code());
+  return grpc::health::v1::HealthCheckResponse::ServingStatus_Name(reply.status());
+}
+
+::testing::AssertionResult has_status(const grpc::Status& status, grpc::StatusCode code, const std::string& text) {
+  if (status.error_code() == code && status.error_message().find(text) != std::string::npos)
+    return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "status " << status.error_code() << " \"" << status.error_message()
+                                       << "\", expected " << code << " with \"" << text << "\"";
+}
+
+void set_timeout(grpc::ClientContext& context, std::chrono::milliseconds timeout) {
+  context.set_deadline(std::chrono::system_clock::now() + timeout);
+}
+
+}  // namespace k4reg::test
