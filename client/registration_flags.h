@@ -8,6 +8,12 @@
 
 namespace k4reg::cli {
 
-void add_registration_flags(CLI::App& command, RegistrationParams& params);
+// The option behind each flag, so a remote command can tell which ones the user gave (Option::count()).
+struct RegistrationFlags {
+  CLI::Option *min_scale, *overlap, *no_icp, *seed, *threads, *time_budget, *bases, *octaves, *scales_per_octave,
+      *min_contrast, *signal, *method, *plain_voxel;
+};
+
+RegistrationFlags add_registration_flags(CLI::App& command, RegistrationParams& params);
 
 }  // namespace k4reg::cli

@@ -1,0 +1,613 @@
+#include "compare_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace k4reg::bench {
+namespace {
+
+// ---- formatting ----
+
+std::string fmt(const char* format, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, format, value);
+  return buffer;
+}
+
+std::string size_label(std::size_t points) { return points == 0 ? "–" : fmt("%.1fM", points / 1e6); }
+
+std::string sigma_label(double sigma_m) { return sigma_m < 1.0 ? fmt("%g mm", sigma_m * 1000.0) : fmt("%g m", sigma_m); }
+
+std::string percent(double fraction) { return std::isnan(fraction) ? "–" : fmt("%.0f %%", 100.0 * fraction); }
+
+std::string number(double value, const char* format) { return std::isnan(value) ? "–" : fmt(format, value); }
+
+// Lengths in metres, with enough digits for the bunny's millimetres.
+std::string metres(double value) {
+  if (std::isnan(value)) return "–";
+  return value < 0.01 ? fmt("%.4f", value) : value < 1.0 ? fmt("%.3f", value) : fmt("%.2f", value);
+}
+
+std::string seconds(double value) {
+  if (std::isnan(value)) return "–";
+  return value < 10 ? fmt("%.2f", value) : value < 100 ? fmt("%.1f", value) : fmt("%.0f", value);
+}
+
+const char* method_label(const std::string& method) {
+  if (method == kOursK4pcs) return "K-4PCS k4reg";
+  if (method == kPclK4pcs) return "K-4PCS PCL";
+  if (method == kOursPlain) return "4PCS k4reg";
+  if (method == kPclPlain) return "4PCS PCL";
+  if (method == kOursMatch) return "4PCS stage k4reg";
+  if (method == kPclMatch) return "KFPCS stage PCL";
+  return "?";
+}
+
+bool is_ours(const std::string& method) { return method == kOursK4pcs || method == kOursPlain || method == kOursMatch; }
+
+// ---- statistics ----
+
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+
+double median(std::vector<double> v) {
+  if (v.empty()) return kNan;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double minimum(const std::vector<double>& v) { return v.empty() ? kNan : *std::min_element(v.begin(), v.end()); }
+double maximum(const std::vector<double>& v) { return v.empty() ? kNan : *std::max_element(v.begin(), v.end()); }
+double mean(const std::vector<double>& v) {
+  if (v.empty()) return kNan;
+  double sum = 0;
+  for (double x : v) sum += x;
+  return sum / v.size();
+}
+
+// All runs of one method on one (suite, size, sigma): one line of the tables.
+struct Row {
+  std::size_t suite = 0, points = 0;
+  double sigma_m = 0;
+  std::string method;
+  std::vector<const Run*> runs;
+  std::set<std::size_t> cases;
+
+  std::vector<double> collect(const std::function<double(const Run&)>& f, bool only_ok = true) const {
+    std::vector<double> v;
+    for (const Run* r : runs)
+      if (!only_ok || r->ok) v.push_back(f(*r));
+    return v;
+  }
+  double success_rate(bool final) const {
+    if (runs.empty()) return kNan;
+    std::size_t hits = 0;
+    for (const Run* r : runs) hits += final ? r->success_final : r->success_coarse;
+    return double(hits) / runs.size();
+  }
+  std::size_t count(const std::function<bool(const Run&)>& f) const {
+    return std::count_if(runs.begin(), runs.end(), [&](const Run* r) { return f(*r); });
+  }
+  std::string time_cell() const {
+    const auto t = collect([](const Run& r) { return r.total_s; });
+    if (t.empty()) return "–";
+    return seconds(median(t)) + " (" + seconds(minimum(t)) + "–" + seconds(maximum(t)) + ")";
+  }
+  double stage_median(const std::string& stage) const {
+    std::vector<double> v;
+    for (const Run* r : runs)
+      if (r->ok && r->stages.count(stage)) v.push_back(r->stages.at(stage));
+    return median(v);
+  }
+  std::vector<std::string> stage_names() const {
+    std::vector<std::string> names;
+    for (const Run* r : runs)
+      for (const auto& [stage, s] : r->stages)
+        if (std::find(names.begin(), names.end(), stage) == names.end()) names.push_back(stage);
+    return names;
+  }
+};
+
+// Keypoints per scan (mean of source and target): from the keypoint job for the detectors (seed-free),
+// from the runs for the plain grids and the given keypoints.
+double keypoints(const Row& row, const Report& report) {
+  std::vector<double> v;
+  if (row.method == kOursK4pcs || row.method == kPclK4pcs) {
+    for (std::size_t c : row.cases) {
+      const DetectorStats& d = row.method == kOursK4pcs ? report.keypoints[c].ours : report.keypoints[c].pcl;
+      if (d.ok) v.push_back(0.5 * (d.source + d.target));
+    }
+  } else {
+    for (const Run* r : row.runs)
+      if (r->source_keypoints > 0) v.push_back(0.5 * (r->source_keypoints + r->target_keypoints));
+  }
+  return mean(v);
+}
+
+// Largest peak RSS of the row's processes (runs that were not started have none).
+double peak_rss_mb(const Row& row) {
+  std::vector<double> v;
+  for (const Run* r : row.runs)
+    if (r->peak_rss_mb > 0) v.push_back(r->peak_rss_mb);
+  return maximum(v);
+}
+
+double repeatability(const Row& row, const Report& report) {
+  if (row.method != kOursK4pcs && row.method != kPclK4pcs) return kNan;
+  std::vector<double> v;
+  for (std::size_t c : row.cases) {
+    const DetectorStats& d = row.method == kOursK4pcs ? report.keypoints[c].ours : report.keypoints[c].pcl;
+    if (d.ok) v.push_back(d.repeatability);
+  }
+  return mean(v);
+}
+
+double plain_spacing(const Row& row, const Report& report) {
+  std::vector<double> v;
+  for (std::size_t c : row.cases)
+    if (report.keypoints[c].plain_voxel_m > 0) v.push_back(report.keypoints[c].plain_voxel_m);
+  return median(v);
+}
+
+std::vector<Row> make_rows(const Report& report) {
+  std::vector<Row> rows;
+  for (const Run& run : report.runs) {
+    const Case& c = report.cases[run.case_index];
+    auto it = std::find_if(rows.begin(), rows.end(), [&](const Row& r) {
+      return r.suite == c.suite && r.points == c.points && r.sigma_m == c.job.sigma_m && r.method == run.method;
+    });
+    if (it == rows.end()) {
+      rows.push_back(Row{c.suite, c.points, c.job.sigma_m, run.method, {}, {}});
+      it = rows.end() - 1;
+    }
+    it->runs.push_back(&run);
+    it->cases.insert(run.case_index);
+  }
+  return rows;
+}
+
+const Row* find_row(const std::vector<Row>& rows, std::size_t suite, std::size_t points, double sigma_m,
+                    const std::string& method) {
+  for (const Row& r : rows)
+    if (r.suite == suite && r.points == points && std::abs(r.sigma_m - sigma_m) < 1e-9 && r.method == method) return &r;
+  return nullptr;
+}
+
+// "SR" cell: coarse success rate, with a dagger when some runs hit the wall-time cap.
+std::string sr_cell(const Row* row) {
+  if (!row) return "–";
+  const std::size_t capped = row->count([](const Run& r) { return r.capped; });
+  return percent(row->success_rate(false)) + (capped ? "†" : "");
+}
+
+std::string rmse_cell(const Row* row) {
+  return row ? metres(median(row->collect([](const Run& r) { return r.coarse.rmse_m; }))) : "–";
+}
+
+std::string time_median_cell(const Row* row) {
+  return row ? seconds(median(row->collect([](const Run& r) { return r.total_s; }))) : "–";
+}
+
+std::size_t suite_index(const Report& report, const std::string& name) {
+  for (std::size_t i = 0; i < report.suites.size(); ++i)
+    if (report.suites[i].name == name) return i;
+  return report.suites.size();
+}
+
+// ---- the paper's numbers (Theiler et al. 2014, real Z+F scans), for orientation only ----
+
+struct PaperCell {
+  double sigma_mm;
+  std::size_t points;
+  int kp, sr;
+};
+constexpr PaperCell kPaperTable2[] = {
+    {100, 700000, 1100, 91}, {100, 2500000, 1100, 95}, {100, 10000000, 1200, 95},
+    {50, 700000, 2800, 98},  {50, 2500000, 2800, 98},  {50, 10000000, 3200, 98},
+    {25, 700000, 5900, 98},  {25, 2500000, 6800, 97},  {25, 10000000, 8200, 100},
+};
+
+struct PaperComparison {
+  double sigma_mm;
+  const char* four_pcs;   // SR / RMSE / T of 4PCS
+  const char* k4pcs;      // SR / RMSE / T (/ KP) of K-4PCS
+};
+constexpr PaperComparison kPaperTable3[] = {{100, "4 % / 0.66 m / 18 s (900 mm grid)", "91 % / 0.15 m / 8 s"},
+                                            {50, "35 % / 0.46 m / 589 s (500 mm grid)", "98 % / 0.06 m / 41 s"},
+                                            {25, "62 % / 0.28 m / 9637 s (350 mm grid)", "98 % / 0.04 m / 102 s"}};
+constexpr PaperComparison kPaperTable4[] = {
+    {100, "10 % / 0.80 m / 652 s (1500 mm grid)", "57 % / 0.52 m / 182 s / KP 2900"},
+    {50, "30 % / 0.79 m / 9800 s (1000 mm grid)", "100 % / 0.40 m / 663 s / KP 6000"},
+    {25, "N.A. (> 72 h)", "83 % / 0.17 m / 2047 s / KP 10400"}};
+
+std::vector<double> sigmas_of(const Suite& suite) {
+  std::vector<double> s = suite.sigmas_m;
+  std::sort(s.rbegin(), s.rend());  // the paper lists the largest scale first
+  return s;
+}
+
+// ---- markdown sections ----
+
+void configuration_section(std::ostringstream& md, const Report& report) {
+  md << "**Configuration** (one per suite, the same for every pair; no per-pair tuning):\n\n"
+     << "| suite | data | pairs | σ | overlap | success | trials | plain 4PCS | k4reg bases | PCL iterations cap "
+        "| wall cap |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const Suite& s : report.suites) {
+    std::string sigmas, sizes;
+    for (double sigma : s.sigmas_m) sigmas += (sigmas.empty() ? "" : ", ") + sigma_label(sigma);
+    for (std::size_t n : s.sizes) sizes += (sizes.empty() ? " at " : ", ") + size_label(n);
+    const std::string success = s.max_rotation_deg > 0
+                                    ? fmt("≤ %g°", s.max_rotation_deg) + fmt(" and ≤ %g m", s.max_translation_m)
+                                    : "RMSE < " + metres(s.success_rmse_m) + " m";
+    std::string baseline = "no";
+    if (s.baseline)
+      baseline = (s.baseline_size ? "at " + size_label(s.baseline_size) : std::string("yes")) + ", " +
+                 std::to_string(s.baseline_trials ? s.baseline_trials : s.trials) + " trials";
+    md << "| " << s.name << " | " << s.data << sizes << " | " << s.pairs << " | " << sigmas << " | " << s.overlap
+       << " | " << success << " | " << s.trials << " | " << baseline << " | "
+       << (s.max_bases ? std::to_string(s.max_bases) : "auto") << " | " << s.pcl_iterations << " | " << s.cap_s
+       << " s |\n";
+  }
+  md << "\n";
+}
+
+void table2(std::ostringstream& md, const Report& report, const std::vector<Row>& rows) {
+  const std::size_t lab = suite_index(report, "lab");
+  if (lab == report.suites.size()) return;
+  const Suite& suite = report.suites[lab];
+  md << "#### Table 2 – indoor lab (simulated): keypoints per scan (KP) and success rate (SR), k4reg / PCL (paper)\n\n"
+     << "| σ |";
+  for (std::size_t n : suite.sizes) md << " S = " << size_label(n) << " KP | SR |";
+  md << "\n|---|";
+  for (std::size_t i = 0; i < suite.sizes.size(); ++i) md << "---|---|";
+  md << "\n";
+  for (double sigma : sigmas_of(suite)) {
+    md << "| " << sigma_label(sigma) << " |";
+    for (std::size_t n : suite.sizes) {
+      const Row* ours = find_row(rows, lab, n, sigma, kOursK4pcs);
+      const Row* pcl = find_row(rows, lab, n, sigma, kPclK4pcs);
+      std::string paper_kp = "–", paper_sr = "–";
+      for (const PaperCell& p : kPaperTable2)
+        if (std::abs(p.sigma_mm - sigma * 1000) < 1e-6 && p.points == n)
+          paper_kp = std::to_string(p.kp), paper_sr = std::to_string(p.sr) + " %";
+      md << " " << number(ours ? keypoints(*ours, report) : kNan, "%.0f") << " / "
+         << number(pcl ? keypoints(*pcl, report) : kNan, "%.0f") << " (" << paper_kp << ") | " << sr_cell(ours) << " / "
+         << sr_cell(pcl) << " (" << paper_sr << ") |";
+    }
+    md << "\n";
+  }
+  md << "\n";
+}
+
+// Tables 3 and 4: 4PCS vs K-4PCS, PCL and ours, at one scan size.
+void comparison_table(std::ostringstream& md, const Report& report, const std::vector<Row>& rows, const char* title,
+                      const std::string& suite_name, std::size_t points, const PaperComparison (&paper)[3]) {
+  const std::size_t index = suite_index(report, suite_name);
+  if (index == report.suites.size()) return;
+  const Suite& suite = report.suites[index];
+  if (std::find(suite.sizes.begin(), suite.sizes.end(), points) == suite.sizes.end()) return;
+  md << "#### " << title << "\n\n"
+     << "| σ (K-4PCS) | 4PCS grid | 4PCS PCL SR | RMSE | T | 4PCS k4reg SR | RMSE | T | K-4PCS PCL SR | RMSE | T | KP "
+        "| K-4PCS k4reg SR | RMSE | T | KP | paper 4PCS | paper K-4PCS |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (double sigma : sigmas_of(suite)) {
+    const Row* rows4[] = {find_row(rows, index, points, sigma, kPclPlain), find_row(rows, index, points, sigma, kOursPlain),
+                          find_row(rows, index, points, sigma, kPclK4pcs), find_row(rows, index, points, sigma, kOursK4pcs)};
+    const Row* any = rows4[3] ? rows4[3] : rows4[2] ? rows4[2] : rows4[1] ? rows4[1] : rows4[0];
+    md << "| " << sigma_label(sigma) << " | " << (any ? metres(plain_spacing(*any, report)) + " m" : "–");
+    for (int m = 0; m < 4; ++m) {
+      md << " | " << sr_cell(rows4[m]) << " | " << rmse_cell(rows4[m]) << " | " << time_median_cell(rows4[m]);
+      if (m >= 2) md << " | " << number(rows4[m] ? keypoints(*rows4[m], report) : kNan, "%.0f");
+    }
+    std::string paper4 = "–", paperk = "–";
+    for (const PaperComparison& p : paper)
+      if (std::abs(p.sigma_mm - sigma * 1000) < 1e-6) paper4 = p.four_pcs, paperk = p.k4pcs;
+    md << " | " << paper4 << " | " << paperk << " |\n";
+  }
+  md << "\nSR and RMSE (median, m) are those of the coarse alignment, as in the paper; T = median seconds from "
+        "loaded clouds to the transform (k4reg includes its ICP).\n\n";
+}
+
+void real_table(std::ostringstream& md, const Report& report, const std::vector<Row>& rows) {
+  md << "#### Real scans with ground truth\n\n"
+     << "| data | method | runs | KP | SR | SR after ICP | MAE ° | MTE m | RMSE m | T s median (min–max) | "
+        "peak RSS MB | repeatability |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const Row& row : rows) {
+    if (!report.suites[row.suite].sizes.empty()) continue;
+    md << "| " << report.suites[row.suite].name << " | " << method_label(row.method) << " | " << row.runs.size() << " | "
+       << number(keypoints(row, report), "%.0f") << " | " << sr_cell(&row) << " | "
+       << (is_ours(row.method) && row.method != kOursMatch ? percent(row.success_rate(true)) : "–") << " | "
+       << number(median(row.collect([](const Run& r) { return r.coarse.mae_deg; })), "%.2f") << " | "
+       << metres(median(row.collect([](const Run& r) { return r.coarse.mte_m; }))) << " | "
+       << metres(median(row.collect([](const Run& r) { return r.coarse.rmse_m; }))) << " | " << row.time_cell()
+       << " | " << number(peak_rss_mb(row), "%.0f") << " | "
+       << percent(repeatability(row, report)) << " |\n";
+  }
+  md << "\nMAE, MTE and RMSE: medians of the coarse result. \"SR after ICP\": the final transform of k4reg's "
+        "pipeline (PCL's methods have no refinement stage).\n\n";
+}
+
+std::string stage_cell(const Row& row) {
+  std::string cell;
+  for (const std::string& stage : row.stage_names())
+    cell += (cell.empty() ? "" : ", ") + stage + " " + seconds(row.stage_median(stage));
+  return cell.empty() ? "–" : cell;
+}
+
+void every_row_table(std::ostringstream& md, const Report& report, const std::vector<Row>& rows) {
+  md << "#### Every row\n\n"
+     << "| suite | S | σ | method | runs | failed / capped | KP | SR coarse | SR final | MAE ° | MTE m | RMSE coarse m "
+        "| RMSE final m | stage medians s | T s median (min–max) | read s | peak RSS MB | repeatability |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const Row& row : rows) {
+    const std::size_t failed = row.count([](const Run& r) { return !r.ok; });
+    const std::size_t capped = row.count([](const Run& r) { return r.capped; });
+    md << "| " << report.suites[row.suite].name << " | " << size_label(row.points) << " | " << sigma_label(row.sigma_m)
+       << " | " << method_label(row.method) << " | " << row.runs.size() << " | " << failed << " / " << capped << " | "
+       << number(keypoints(row, report), "%.0f") << " | " << percent(row.success_rate(false)) << " | "
+       << percent(row.success_rate(true)) << " | "
+       << number(median(row.collect([](const Run& r) { return r.coarse.mae_deg; })), "%.2f") << " | "
+       << metres(median(row.collect([](const Run& r) { return r.coarse.mte_m; }))) << " | "
+       << metres(median(row.collect([](const Run& r) { return r.coarse.rmse_m; }))) << " | "
+       << metres(median(row.collect([](const Run& r) { return r.final.rmse_m; }))) << " | " << stage_cell(row) << " | "
+       << row.time_cell() << " | " << seconds(median(row.collect([](const Run& r) { return r.read_s; }))) << " | "
+       << number(peak_rss_mb(row), "%.0f") << " | "
+       << percent(repeatability(row, report)) << " |\n";
+  }
+  md << "\n";
+}
+
+std::string detector_cells(const DetectorStats& d) {
+  if (!d.ok) return "failed: " + d.error + " | – | ≥ " + seconds(d.seconds) + " | " + number(d.peak_rss_mb, "%.0f");
+  return std::to_string(d.source) + " / " + std::to_string(d.target) + " | " + percent(d.repeatability) + " | " +
+         seconds(d.seconds) + " | " + number(d.peak_rss_mb, "%.0f");
+}
+
+void keypoint_table(std::ostringstream& md, const Report& report) {
+  md << "#### Keypoint detectors per pair (run once per pair in their own processes; both are deterministic)\n\n"
+     << "| suite | S | σ | pair | k4reg KP src / tgt | repeatability | s | MB | PCL SIFT KP src / tgt | repeatability "
+        "| s | MB | SIFT octaves over VoxelGrid's limit | voxel overlap under the truth | 4PCS grid m |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (std::size_t i = 0; i < report.cases.size(); ++i) {
+    const Case& c = report.cases[i];
+    const KeypointStats& k = report.keypoints[i];
+    if (!k.ran) continue;
+    md << "| " << report.suites[c.suite].name << " | " << size_label(c.points) << " | " << sigma_label(c.job.sigma_m)
+       << " | " << c.pair << " | " << detector_cells(k.ours) << " | " << detector_cells(k.pcl) << " | "
+       << k.pcl.sift_overflow_octaves << " | " << percent(k.ours.ok ? k.truth_overlap : kNan) << " | "
+       << (k.plain_voxel_m > 0 ? metres(k.plain_voxel_m) : "–") << " |\n";
+  }
+  md << "\nRepeatability: share of source keypoints with a target keypoint within 2σ after the ground truth "
+        "(bounded by the overlap). Voxel overlap under the truth: the same measure on the σ voxel grids – a check of "
+        "the ground truth and the pair's real overlap. s and MB: both scans, one detector run, peak RSS of that process. SIFT octaves "
+        "over the limit: pcl::VoxelGrid refuses grids of more than 2^31 cells and passes the unfiltered cloud on, "
+        "so SIFT then works on raw points (slow).\n\n";
+}
+
+void failures_section(std::ostringstream& md, const Report& report) {
+  std::map<std::string, int> counts;
+  for (const Run& r : report.runs)
+    if (!r.ok || r.capped)
+      ++counts[std::string(method_label(r.method)) + " on " + report.suites[report.cases[r.case_index].suite].name +
+               ": " + (r.error.empty() ? "over the wall-time cap" : r.error)];
+  if (counts.empty()) return;
+  md << "#### Runs without a usable result\n\n";
+  for (const auto& [what, n] : counts) md << "- " << n << " × " << what << "\n";
+  md << "\n";
+}
+
+// ---- CSV and plots ----
+
+std::string csv_escape(const std::string& s) {
+  std::string out = "\"";
+  for (char ch : s) out += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return out + "\"";
+}
+
+// Every stage name any run reported, in first-seen order (the core's stages may change).
+std::vector<std::string> all_stages(const Report& report) {
+  std::vector<std::string> names;
+  for (const Run& r : report.runs)
+    for (const auto& [stage, s] : r.stages)
+      if (std::find(names.begin(), names.end(), stage) == names.end()) names.push_back(stage);
+  return names;
+}
+
+void write_runs_csv(const Report& report, const std::string& path) {
+  std::ofstream out(path);
+  out << "suite,pair,points,sigma_m,method,trial,ok,capped,success_coarse,success_final,"
+         "coarse_mae_deg,coarse_mte_m,coarse_rotation_deg,coarse_translation_m,coarse_rmse_m,"
+         "final_mae_deg,final_mte_m,final_rotation_deg,final_translation_m,final_rmse_m,"
+         "source_keypoints,target_keypoints,read_s,convert_s,total_s";
+  const std::vector<std::string> stages = all_stages(report);
+  for (const std::string& stage : stages) out << "," << stage << "_s";
+  out << ",peak_rss_mb,sift_overflow_octaves,error\n";
+  for (const Run& r : report.runs) {
+    const Case& c = report.cases[r.case_index];
+    out << report.suites[c.suite].name << "," << c.pair << "," << c.points << "," << c.job.sigma_m << "," << r.method
+        << "," << r.trial << "," << r.ok << "," << r.capped << "," << r.success_coarse << "," << r.success_final;
+    for (const Errors* e : {&r.coarse, &r.final})
+      out << "," << e->mae_deg << "," << e->mte_m << "," << e->rotation_deg << "," << e->translation_m << "," << e->rmse_m;
+    out << "," << r.source_keypoints << "," << r.target_keypoints << "," << r.read_s << "," << r.convert_s << ","
+        << r.total_s;
+    for (const std::string& stage : stages) out << "," << (r.stages.count(stage) ? fmt("%.4f", r.stages.at(stage)) : "");
+    out << "," << r.peak_rss_mb << "," << r.sift_overflow_octaves << "," << csv_escape(r.error) << "\n";
+  }
+}
+
+void write_rows_csv(const Report& report, const std::vector<Row>& rows, const std::string& path) {
+  std::ofstream out(path);
+  out << "suite,points,sigma_m,method,runs,failed,capped,keypoints,sr_coarse,sr_final,mae_deg,mte_m,rmse_coarse_m,"
+         "rmse_final_m,total_median_s,total_min_s,total_max_s,read_median_s";
+  const std::vector<std::string> stages = all_stages(report);
+  for (const std::string& stage : stages) out << "," << stage << "_median_s";
+  out << ",peak_rss_max_mb,repeatability,plain_voxel_m\n";
+  for (const Row& row : rows) {
+    const auto total = row.collect([](const Run& r) { return r.total_s; });
+    out << report.suites[row.suite].name << "," << row.points << "," << row.sigma_m << "," << row.method << ","
+        << row.runs.size() << "," << row.count([](const Run& r) { return !r.ok; }) << ","
+        << row.count([](const Run& r) { return r.capped; }) << "," << keypoints(row, report) << ","
+        << row.success_rate(false) << "," << row.success_rate(true) << ","
+        << median(row.collect([](const Run& r) { return r.coarse.mae_deg; })) << ","
+        << median(row.collect([](const Run& r) { return r.coarse.mte_m; })) << ","
+        << median(row.collect([](const Run& r) { return r.coarse.rmse_m; })) << ","
+        << median(row.collect([](const Run& r) { return r.final.rmse_m; })) << "," << median(total) << ","
+        << minimum(total) << "," << maximum(total) << ","
+        << median(row.collect([](const Run& r) { return r.read_s; }));
+    for (const std::string& stage : stages) out << "," << row.stage_median(stage);
+    out << "," << peak_rss_mb(row) << ","
+        << repeatability(row, report) << "," << plain_spacing(row, report) << "\n";
+  }
+}
+
+// A self-contained gnuplot script (data inline) writing <stem>.png next to itself.
+struct Series {
+  std::string title;
+  std::vector<std::vector<double>> points;  // x, y[, ylow, yhigh]
+};
+
+void write_plot(const std::string& path, const std::string& png, const std::string& settings,
+                const std::vector<Series>& series, const char* style) {
+  std::ofstream out(path);
+  out << "# Generated by k4reg-bench-compare; run `gnuplot " << std::filesystem::path(path).filename().string()
+      << "` in this folder.\nset terminal pngcairo size 900,600 noenhanced font 'sans,11'\nset output '" << png
+      << "'\nset key outside right\nset grid\n"
+      << settings;
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    out << "$d" << i << " << EOD\n";
+    for (const auto& p : series[i].points) {
+      for (double v : p) out << v << " ";
+      out << "\n";
+    }
+    out << "EOD\n";
+  }
+  out << "plot ";
+  for (std::size_t i = 0; i < series.size(); ++i)
+    out << (i ? ", \\\n     " : "") << "$d" << i << " " << style << " title '" << series[i].title << "'";
+  out << (series.empty() ? "NaN notitle" : "") << "\n";
+}
+
+void write_plots(const Report& report, const std::vector<Row>& rows, const std::string& dir,
+                 const std::string& stem) {
+  const std::size_t lab = suite_index(report, "lab");
+  if (lab == report.suites.size()) return;
+  const Suite& suite = report.suites[lab];
+  std::vector<Series> sr, time;
+  for (const char* method : {kOursK4pcs, kPclK4pcs}) {
+    for (std::size_t n : suite.sizes) {
+      Series s{std::string(method_label(method)) + " " + size_label(n), {}};
+      for (double sigma : suite.sigmas_m)
+        if (const Row* row = find_row(rows, lab, n, sigma, method))
+          s.points.push_back({sigma * 1000.0, 100.0 * row->success_rate(false)});
+      std::sort(s.points.begin(), s.points.end());
+      if (!s.points.empty()) sr.push_back(s);
+    }
+    for (double sigma : suite.sigmas_m) {
+      Series s{std::string(method_label(method)) + " σ " + sigma_label(sigma), {}};
+      for (std::size_t n : suite.sizes)
+        if (const Row* row = find_row(rows, lab, n, sigma, method)) {
+          const auto t = row->collect([](const Run& r) { return r.total_s; });
+          if (!t.empty()) s.points.push_back({n / 1e6, median(t), minimum(t), maximum(t)});
+        }
+      if (!s.points.empty()) time.push_back(s);
+    }
+  }
+  write_plot(dir + "/" + stem + "-sr-vs-sigma.gp", stem + "-sr-vs-sigma.png",
+             "set title 'Indoor lab (simulated): coarse success rate vs minimum scale'\n"
+             "set xlabel 'minimum DoG scale sigma (mm)'\nset ylabel 'success rate (%)'\n"
+             "set logscale x 2\nset xrange [20:120]\nset yrange [0:105]\nset xtics (25, 50, 100)\n",
+             sr, "with linespoints lw 2 pt 7");
+  write_plot(dir + "/" + stem + "-time-vs-size.gp", stem + "-time-vs-size.png",
+             "set title 'Indoor lab (simulated): time per pair vs scan size (median, bars min-max)'\n"
+             "set xlabel 'points per scan (millions)'\nset ylabel 'seconds'\nset logscale xy\n"
+             "set xrange [0.5:14]\nset xtics (0.7, 2.5, 10)\n",
+             time, "with yerrorlines lw 2 pt 7");
+}
+
+}  // namespace
+
+void write_outputs(const Report& report, const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  const std::vector<Row> rows = make_rows(report);
+  const std::string stem = "compare-" + report.mode;
+  write_runs_csv(report, dir + "/" + stem + "-runs.csv");
+  write_rows_csv(report, rows, dir + "/" + stem + "-rows.csv");
+  write_plots(report, rows, dir, stem);
+}
+
+std::string markdown(const Report& report, const std::string& results_dir_in_repo) {
+  const std::vector<Row> rows = make_rows(report);
+  const std::string stem = results_dir_in_repo + "/compare-" + report.mode;
+  std::ostringstream md;
+  md << "### K-4PCS and 4PCS: k4reg vs PCL 1.13 (" << report.mode << " run)\n\n"
+     << "Started " << report.started << ", took " << seconds(report.duration_s / 60.0) << " min. Command: `"
+     << report.command << "`. Raw data: `" << stem << "-runs.csv` (one line per run), `" << stem
+     << "-rows.csv` (one line per table row).\n\n";
+  configuration_section(md, report);
+  md << "How the runs are made:\n\n"
+     << "- Every run (one method, one pair, one trial) is a fresh process: its peak RSS (getrusage of that "
+        "child) is that method's alone, including its copy of the two clouds; a run still going "
+     << kHardLimitSlack_s << " s after the wall cap is killed and counted as failed, and each process has an address-space cap "
+        "(--memory-cap-mb, 12 GB by default; the machine is shared) past which the run fails as out of memory. "
+        "Runs are interleaved (trial 1: k4reg K-4PCS, PCL K-4PCS, k4reg 4PCS, "
+        "PCL 4PCS; trial 2: …).\n"
+     << "- T is the time from the two loaded clouds to the transform (file reading is the separate \"read\" "
+        "column; copying into PCL clouds is not counted for PCL). k4reg uses both cores (TBB); PCL's "
+        "KFPCS/FPCS use 2 OpenMP threads, its SIFTKeypoint is single-threaded.\n"
+     << "- k4reg is seeded with the trial number (1, 2, …). PCL cannot be seeded (it calls srand(time())), so "
+        "its trials differ by chance: the min–max of T and the SR over trials are its spread.\n"
+     << "- PCL K-4PCS = `SIFTKeypoint<PointXYZI, PointWithScale>` (setScales(σ, 5, 5), setMinimumContrast(0.01 × "
+        "the intensity range)) on each full cloud, then `KFPCSInitialAlignment` with setDelta(σ, false), "
+        "setApproxOverlap(o), setScoreThreshold(0), setMaximumIterations(cap), setMaxComputationTime(wall cap), "
+        "setNumberOfThreads(2). Clouds without intensity get PCL's geometric stand-in: NormalEstimationOMP "
+        "curvature (radius 3σ) on a σ VoxelGrid, as the SIFT field. A run over the wall cap is a failure (†).\n"
+     << "- PCL 4PCS = `VoxelGrid` at the spacing where our voxelised source has about as many points as our "
+        "keypoints (the paper's baseline), then `FPCSInitialAlignment` with δ = that spacing (absolute) and the "
+        "same settings. k4reg 4PCS = `register_clouds` with method = kPlain4pcs on the same spacing.\n"
+     << "- Coarse = before ICP (for k4reg the best hypothesis after its symmetry guard, i.e. what icp = false "
+        "returns); SR in Tables 2–4 is the coarse success as in the paper. Real-data sources are moved by a fixed "
+        "random rigid motion (30–180°) first, so that a method returning the identity cannot pass on pairs whose "
+        "true motion is small.\n\n";
+  table2(md, report, rows);
+  comparison_table(md, report, rows, "Table 3 – indoor lab (simulated), S = 0.7M: 4PCS vs K-4PCS", "lab", 700000,
+                   kPaperTable3);
+  comparison_table(md, report, rows, "Table 4 – outdoor arch (simulated), S = 1.5M: 4PCS vs K-4PCS", "arch", 1500000,
+                   kPaperTable4);
+  real_table(md, report, rows);
+  every_row_table(md, report, rows);
+  keypoint_table(md, report);
+  failures_section(md, report);
+  if (suite_index(report, "lab") < report.suites.size())
+    md << "![success rate vs sigma](" << stem << "-sr-vs-sigma.png)\n![time vs size](" << stem
+       << "-time-vs-size.png)\n\n";
+  md << "Paper values (in parentheses and in the \"paper\" columns) are from real Z+F scans of a real lab and "
+        "arch (Theiler et al. 2014, Tables 2–4); our scenes are simulated look-alikes, so compare trends, not "
+        "digits.\n";
+  return md.str();
+}
+
+void replace_block(const std::string& file, const std::string& name, const std::string& content) {
+  const std::string begin = "<!-- " + name + ":begin -->", end = "<!-- " + name + ":end -->";
+  std::string text;
+  if (std::ifstream in(file); in) text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  const std::string block = begin + "\n" + content + (content.ends_with("\n") ? "" : "\n") + end;
+  const std::size_t b = text.find(begin), e = text.find(end);
+  if (b != std::string::npos && e != std::string::npos && e > b)
+    text.replace(b, e + end.size() - b, block);
+  else
+    text += (text.empty() || text.ends_with("\n") ? "" : "\n") + std::string("\n") + block + "\n";
+  std::ofstream out(file);
+  if (!out) throw std::runtime_error("cannot write " + file);
+  out << text;
+}
+
+}  // namespace k4reg::bench

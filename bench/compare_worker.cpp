@@ -1,0 +1,359 @@
+// The worker side of the comparison: loads one pair, runs one method and reports errors against the
+// ground truth, stage times and keypoint counts as one JSON object.
+//
+// Result fields: ok, error, read_s (file reading, not part of total_s), convert_s (copying into PCL
+// clouds, not part of total_s), total_s (from loaded clouds to the final transform), stages {name: s},
+// source_keypoints, target_keypoints, capped (over the wall-time cap: a failure), coarse and final
+// {mae_deg, mte_m, rotation_deg, translation_m, rmse_m} (coarse = before ICP; PCL has no ICP, so they
+// are equal), sift_overflow_octaves. The keypoint jobs report seconds, source_keypoints, target_keypoints,
+// repeatability, and truth_overlap / plain_voxel_m (ours) or sift_overflow_octaves (PCL). A worker prints
+// "PROGRESS {...}" lines with facts known before a long stage, then one "RESULT {...}" line.
+#include <Eigen/Geometry>
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <random>
+
+#include "compare_job.h"
+#include "k4reg/cloud_io.h"
+#include "k4reg/dog_keypoints.h"
+#include "k4reg/error.h"
+#include "k4reg/four_pcs.h"
+#include "k4reg/metrics.h"
+#include "k4reg/neighbor_grid.h"
+#include "k4reg/registration.h"
+#include "k4reg/surface_signal.h"
+#include "k4reg/voxel_grid.h"
+#include "pcl_methods.h"
+
+namespace k4reg::bench {
+
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+void to_json(json& j, const Job& job) {
+  j = json{{"method", job.method},       {"source", job.source},       {"target", job.target},
+           {"unit_scale", job.unit_scale}, {"max_range_m", job.max_range_m}, {"pose_seed", job.pose_seed},
+           {"sigma_m", job.sigma_m},     {"overlap", job.overlap},     {"plain_voxel_m", job.plain_voxel_m},
+           {"seed", job.seed},           {"max_bases", job.max_bases}, {"pcl_iterations", job.pcl_iterations},
+           {"cap_s", job.cap_s},         {"memory_cap_mb", job.memory_cap_mb}};
+  j["truth"] = std::vector<double>(job.truth.data(), job.truth.data() + 16);  // column-major
+}
+
+void from_json(const json& j, Job& job) {
+  j.at("method").get_to(job.method);
+  j.at("source").get_to(job.source);
+  j.at("target").get_to(job.target);
+  j.at("unit_scale").get_to(job.unit_scale);
+  j.at("max_range_m").get_to(job.max_range_m);
+  j.at("pose_seed").get_to(job.pose_seed);
+  j.at("sigma_m").get_to(job.sigma_m);
+  j.at("overlap").get_to(job.overlap);
+  j.at("plain_voxel_m").get_to(job.plain_voxel_m);
+  j.at("seed").get_to(job.seed);
+  j.at("max_bases").get_to(job.max_bases);
+  j.at("pcl_iterations").get_to(job.pcl_iterations);
+  j.at("cap_s").get_to(job.cap_s);
+  j.at("memory_cap_mb").get_to(job.memory_cap_mb);
+  const auto truth = j.at("truth").get<std::vector<double>>();
+  if (truth.size() != 16) throw std::runtime_error("job: truth needs 16 numbers");
+  job.truth = Eigen::Map<const Eigen::Matrix4d>(truth.data());
+}
+
+namespace {
+
+// Facts known before a long stage, printed at once so the orchestrator still has them if the run is killed.
+void report_progress(const json& facts) {
+  std::printf("PROGRESS %s\n", facts.dump().c_str());
+  std::fflush(stdout);
+}
+
+// SIFT's VoxelGrid overflow is known from the bounding boxes before SIFT starts (and explains a slow SIFT).
+void report_sift_overflow(const PclCloud& source, const PclCloud& target, const SiftParams& sift) {
+  report_progress({{"sift_overflow_octaves", std::max(sift_overflowed_octaves(source, sift),
+                                                      sift_overflowed_octaves(target, sift))}});
+}
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+Eigen::Matrix4d translation(const Eigen::Vector3d& t) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.topRightCorner<3, 1>() = t;
+  return m;
+}
+
+// A transform between the clouds' local frames expressed between the files' frames.
+Eigen::Matrix4d file_from_local(const Eigen::Matrix4d& local, const PointCloud& source, const PointCloud& target) {
+  return translation(target.origin_m) * local * translation(-source.origin_m);
+}
+
+Eigen::Matrix4d local_from_file(const Eigen::Matrix4d& file, const PointCloud& source, const PointCloud& target) {
+  return translation(-target.origin_m) * file * translation(source.origin_m);
+}
+
+struct LoadedPair {
+  PointCloud source, target;
+  Eigen::Matrix4d truth;  // file frames, after scaling and the pose perturbation
+  double read_s = 0.0;
+};
+
+// Scales coordinates and drops no-return points; a cloud that needs neither is returned untouched.
+PointCloud conditioned(PointCloud cloud, double unit_scale, double max_range_m) {
+  if (unit_scale == 1.0 && max_range_m <= 0.0) return cloud;
+  std::vector<Eigen::Vector3d> world;
+  std::vector<float> intensity;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3d p = (cloud.origin_m + cloud.points[i].cast<double>()) * unit_scale;
+    if (max_range_m > 0.0 && p.norm() > max_range_m) continue;
+    world.push_back(p);
+    if (cloud.has_intensity()) intensity.push_back(cloud.intensity[i]);
+  }
+  return make_local_cloud(world, std::move(intensity), "conditioned cloud");
+}
+
+// A random rigid motion: rotation of 30-180 deg about a random axis, translation of half the cloud's size.
+Eigen::Matrix4d random_pose(std::uint64_t seed, double size_m) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal;
+  std::uniform_real_distribution<double> angle_deg(30.0, 180.0);
+  const Eigen::Vector3d axis = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+  const Eigen::Vector3d shift = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized() * 0.5 * size_m;
+  Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
+  pose.topLeftCorner<3, 3>() = Eigen::AngleAxisd(angle_deg(rng) * std::numbers::pi / 180.0, axis).toRotationMatrix();
+  pose.topRightCorner<3, 1>() = shift;
+  return pose;
+}
+
+double extent_m(const PointCloud& cloud) {
+  Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max()), hi = -lo;
+  for (const auto& p : cloud.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  return cloud.empty() ? 0.0 : double((hi - lo).norm());
+}
+
+PointCloud moved(const PointCloud& cloud, const Eigen::Matrix4d& pose) {
+  std::vector<Eigen::Vector3d> world(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    world[i] = (pose * (cloud.origin_m + cloud.points[i].cast<double>()).homogeneous()).head<3>();
+  return make_local_cloud(world, cloud.intensity, "moved source");
+}
+
+LoadedPair load_pair(const Job& job) {
+  LoadedPair pair;
+  const auto start = Clock::now();
+  PointCloud source = read_cloud(job.source), target = read_cloud(job.target);
+  pair.read_s = seconds_since(start);
+  pair.source = conditioned(std::move(source), job.unit_scale, job.max_range_m);
+  pair.target = conditioned(std::move(target), job.unit_scale, job.max_range_m);
+  pair.truth = job.truth;
+  pair.truth.topRightCorner<3, 1>() *= job.unit_scale;
+  if (job.pose_seed != 0) {
+    const Eigen::Matrix4d pose = random_pose(job.pose_seed, extent_m(pair.source));
+    pair.source = moved(pair.source, pose);
+    pair.truth = pair.truth * pose.inverse();
+  }
+  return pair;
+}
+
+// The paper's measures on (at most ~200 k evenly strided) source points.
+json errors(const PointCloud& source, const Eigen::Matrix4d& estimate, const Eigen::Matrix4d& truth) {
+  const std::size_t stride = std::max<std::size_t>(1, source.size() / 200000);
+  std::vector<Eigen::Vector3f> sample;
+  for (std::size_t i = 0; i < source.size(); i += stride) sample.push_back(source.points[i]);
+  const Eigen::Matrix4d shift = translation(source.origin_m);  // metrics take local points
+  const TransformError e = transform_error(sample, estimate * shift, truth * shift);
+  return {{"mae_deg", e.mae_deg},
+          {"mte_m", e.mte_m},
+          {"rotation_deg", e.rotation_deg},
+          {"translation_m", e.translation_m},
+          {"rmse_m", e.rmse_m}};
+}
+
+json stage_times(const std::vector<StageTiming>& timings) {
+  json stages = json::object();
+  for (const StageTiming& t : timings) stages[t.stage] = t.seconds;
+  return stages;
+}
+
+void run_ours(const Job& job, const LoadedPair& pair, json& out) {
+  RegistrationParams params;
+  params.min_scale_m = job.sigma_m;
+  params.overlap = job.overlap;
+  params.seed = job.seed;
+  params.max_bases = job.max_bases;
+  params.time_budget_s = job.cap_s;
+  if (job.method == kOursPlain) {
+    params.method = CoarseMethod::kPlain4pcs;
+    params.plain_voxel_m = job.plain_voxel_m;
+  }
+  const auto start = Clock::now();
+  const RegistrationResult r = register_clouds(pair.source, pair.target, params);
+  out["total_s"] = seconds_since(start);
+  out["stages"] = stage_times(r.timings);
+  out["source_keypoints"] = r.source_keypoints;
+  out["target_keypoints"] = r.target_keypoints;
+  // The best hypothesis after the symmetry guard is exactly what an icp=false run would return.
+  out["coarse"] = errors(pair.source, r.hypotheses.front().transform, pair.truth);
+  out["final"] = errors(pair.source, r.transform, pair.truth);
+}
+
+PclAlignParams pcl_align_params(const Job& job, double delta_m) {
+  return PclAlignParams{delta_m, job.overlap, job.pcl_iterations, job.cap_s, 2};
+}
+
+void run_pcl(const Job& job, const LoadedPair& pair, json& out) {
+  auto start = Clock::now();
+  const PclCloud::Ptr source = to_pcl(pair.source), target = to_pcl(pair.target);
+  out["convert_s"] = seconds_since(start);
+
+  json stages = json::object();
+  PclCloud::Ptr source_set, target_set;
+  double delta = job.sigma_m;
+  start = Clock::now();
+  if (job.method == kPclK4pcs) {
+    const SiftParams sift{job.sigma_m};
+    const bool intensity = pair.source.has_intensity() && pair.target.has_intensity();
+    report_sift_overflow(*source, *target, sift);
+    const SiftKeypoints s = pcl_sift_keypoints(source, intensity, sift), t = pcl_sift_keypoints(target, intensity, sift);
+    out["sift_overflow_octaves"] = std::max(s.overflowed_octaves, t.overflowed_octaves);
+    source_set = s.points, target_set = t.points;
+    stages["keypoints"] = seconds_since(start);
+  } else {
+    delta = job.plain_voxel_m;
+    source_set = pcl_voxel_grid(source, delta), target_set = pcl_voxel_grid(target, delta);
+    out["voxel_grid_overflow"] = pcl_voxel_grid_overflows(*source, delta) || pcl_voxel_grid_overflows(*target, delta);
+    stages["plain_grid"] = seconds_since(start);
+  }
+  out["source_keypoints"] = source_set->size();
+  out["target_keypoints"] = target_set->size();
+  if (source_set->size() < 4 || target_set->size() < 4) fail(ErrorCode::kFailedPrecondition, "too few keypoints");
+
+  start = Clock::now();
+  const PclAlignParams params = pcl_align_params(job, delta);
+  const Eigen::Matrix4d local = job.method == kPclK4pcs ? pcl_kfpcs(source_set, target_set, params)
+                                                       : pcl_fpcs(source_set, target_set, params);
+  stages["matching"] = seconds_since(start);
+  double total = 0.0;
+  for (const auto& [stage, seconds] : stages.items()) total += seconds.get<double>();
+  out["stages"] = stages;
+  out["total_s"] = total;
+  out["capped"] = total > job.cap_s;
+  const json e = errors(pair.source, file_from_local(local, pair.source, pair.target), pair.truth);
+  out["coarse"] = e;
+  out["final"] = e;
+}
+
+// ETH office: the clouds are keypoints already; only the 4PCS stage runs.
+void run_match(const Job& job, const LoadedPair& pair, json& out) {
+  const auto start = Clock::now();
+  Eigen::Matrix4d local;
+  if (job.method == kOursMatch) {
+    FourPcsParams params{job.sigma_m, job.overlap, job.max_bases};
+    params.seed = job.seed;
+    local = match_4pcs(pair.source.points, pair.target.points, params).hypotheses.front().transform;
+  } else {
+    local = pcl_kfpcs(to_pcl(pair.source), to_pcl(pair.target), pcl_align_params(job, job.sigma_m));
+  }
+  out["total_s"] = seconds_since(start);
+  out["stages"] = json{{"matching", out["total_s"]}};
+  out["capped"] = out["total_s"].get<double>() > job.cap_s;
+  out["source_keypoints"] = pair.source.size();
+  out["target_keypoints"] = pair.target.size();
+  const json e = errors(pair.source, file_from_local(local, pair.source, pair.target), pair.truth);
+  out["coarse"] = e;
+  out["final"] = e;
+}
+
+// Our detector exactly as register_clouds runs it (core/src/registration.cpp, steps 1 and 2).
+std::vector<Eigen::Vector3f> our_keypoints(const PointCloud& cloud, bool use_intensity, double sigma_m) {
+  const VoxelizedCloud voxels = voxel_grid(cloud, sigma_m);
+  const RegistrationParams defaults;
+  const SurfaceSignal signal = make_surface_signal(voxels.cloud, sigma_m, defaults.signal, use_intensity);
+  const DogParams dog{sigma_m, defaults.octaves, defaults.scales_per_octave, defaults.min_contrast};
+  return detect_dog_keypoints(voxels.cloud.points, signal.values, dog).points;
+}
+
+// Share of source keypoints with a target keypoint within radius_m once moved by the truth (local frames).
+double repeatability(const std::vector<Eigen::Vector3f>& source, const std::vector<Eigen::Vector3f>& target,
+                     const Eigen::Matrix4d& truth_local, double radius_m) {
+  if (source.empty() || target.empty()) return 0.0;
+  const NeighborGrid grid(target, radius_m);
+  const Eigen::Affine3f t(truth_local.cast<float>());
+  std::size_t hits = 0;
+  for (const auto& p : source) hits += grid.any_within(t * p, static_cast<float>(radius_m));
+  return double(hits) / source.size();
+}
+
+// The plain-4PCS grid spacing: as in the paper (and register_clouds' default), the spacing at which the
+// voxelised source keeps about as many points as it has keypoints.
+double plain_spacing(const PointCloud& source, double sigma_m, std::size_t keypoints) {
+  const PointCloud voxels = voxel_grid(source, sigma_m).cloud;
+  double spacing = 4.0 * sigma_m;
+  for (int step = 0; step < 40 && voxel_grid(voxels, spacing).cloud.size() > keypoints; ++step) spacing *= 1.25;
+  return spacing;
+}
+
+void run_keypoints(const Job& job, const LoadedPair& pair, json& out) {
+  const double sigma = job.sigma_m;
+  const bool intensity = pair.source.has_intensity() && pair.target.has_intensity();
+  const Eigen::Matrix4d truth_local = local_from_file(pair.truth, pair.source, pair.target);
+  std::vector<Eigen::Vector3f> source, target;
+  const auto start = Clock::now();
+  if (job.method == kKeypointsOurs) {
+    source = our_keypoints(pair.source, intensity, sigma);
+    target = our_keypoints(pair.target, intensity, sigma);
+  } else {
+    const SiftParams sift{sigma};
+    const PclCloud::Ptr source_pcl = to_pcl(pair.source), target_pcl = to_pcl(pair.target);
+    report_sift_overflow(*source_pcl, *target_pcl, sift);
+    const SiftKeypoints s = pcl_sift_keypoints(source_pcl, intensity, sift);
+    const SiftKeypoints t = pcl_sift_keypoints(target_pcl, intensity, sift);
+    source = to_points(*s.points), target = to_points(*t.points);
+    out["sift_overflow_octaves"] = std::max(s.overflowed_octaves, t.overflowed_octaves);
+  }
+  out["seconds"] = seconds_since(start);
+  out["source_keypoints"] = source.size();
+  out["target_keypoints"] = target.size();
+  out["repeatability"] = repeatability(source, target, truth_local, 2.0 * sigma);
+  if (job.method == kKeypointsOurs) {
+    // A check of the ground truth (and the true overlap): the same measure on the sigma voxel grids.
+    out["truth_overlap"] = repeatability(voxel_grid(pair.source, sigma).cloud.points,
+                                         voxel_grid(pair.target, sigma).cloud.points, truth_local, 2.0 * sigma);
+    const double spacing = plain_spacing(pair.source, sigma, std::max<std::size_t>(source.size(), 4));
+    out["plain_voxel_m"] = spacing;
+  }
+}
+
+}  // namespace
+
+json run_job(const Job& job) {
+  json out = {{"method", job.method}, {"ok", false}, {"capped", false}};
+  try {
+    const LoadedPair pair = load_pair(job);
+    out["read_s"] = pair.read_s;
+    if (job.method == kOursK4pcs || job.method == kOursPlain) run_ours(job, pair, out);
+    else if (job.method == kPclK4pcs || job.method == kPclPlain) run_pcl(job, pair, out);
+    else if (job.method == kOursMatch || job.method == kPclMatch) run_match(job, pair, out);
+    else if (job.method == kKeypointsOurs || job.method == kKeypointsPcl) run_keypoints(job, pair, out);
+    else throw std::runtime_error("unknown method " + job.method);
+    out["ok"] = true;
+  } catch (const Error& e) {
+    out["error"] = std::string(to_string(e.code())) + ": " + e.what();
+    out["capped"] = e.code() == ErrorCode::kDeadlineExceeded;
+  } catch (const std::bad_alloc&) {
+    out["error"] = "out of memory (over the " + std::to_string(job.memory_cap_mb) + " MB cap)";
+  } catch (const std::exception& e) {
+    out["error"] = e.what();
+  }
+  return out;
+}
+
+void limit_memory(const Job& job) {
+  const rlim_t bytes = static_cast<rlim_t>(job.memory_cap_mb) << 20;
+  const rlimit limit{bytes, bytes};
+  setrlimit(RLIMIT_AS, &limit);
+}
+
+}  // namespace k4reg::bench

@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# bench/run.sh [--quick]
+# Builds the benchmarks, runs the voxel grid benchmark (Google Benchmark, 5 repetitions, medians) and the
+# K-4PCS / 4PCS comparison with PCL 1.13, then rewrites the machine, voxel and compare blocks of
+# bench/RESULTS.md and the files in bench/results/ (CSV, JSON, gnuplot scripts, PNG plots, run log).
+# --quick: a representative subset (about 20 min on 2 cores). Without it: the full suites (hours).
+# Not part of the test suite. Build directory: $K4REG_BENCH_BUILD_DIR (default build-bench).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+mode=full
+quick_flag=()
+case "${1:-}" in
+  --quick) mode=quick; quick_flag=(--quick) ;;
+  "") ;;
+  *) echo "usage: bench/run.sh [--quick]" >&2; exit 2 ;;
+esac
+build=${K4REG_BENCH_BUILD_DIR:-build-bench}
+results=bench/results
+markdown=bench/RESULTS.md
+mkdir -p "$results"
+
+# Replaces the lines between "<!-- NAME:begin -->" and "<!-- NAME:end -->" of FILE by CONTENT_FILE
+# (appends the block when the markers are missing).
+replace_block() {
+  local file=$1 name=$2 content=$3
+  touch "$file"
+  if grep -q "<!-- $name:begin -->" "$file"; then
+    awk -v b="<!-- $name:begin -->" -v e="<!-- $name:end -->" -v c="$content" '
+      $0 == b { print; while ((getline line < c) > 0) print line; skip = 1; next }
+      $0 == e { skip = 0 }
+      !skip { print }' "$file" > "$file.tmp"
+    mv "$file.tmp" "$file"
+  else
+    { echo; echo "<!-- $name:begin -->"; cat "$content"; echo "<!-- $name:end -->"; } >> "$file"
+  fi
+}
+
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DK4REG_BUILD_BENCH=ON -DK4REG_BUILD_SERVICE=OFF \
+  -DK4REG_BUILD_TESTS=OFF > /dev/null
+cmake --build "$build" -j"$(nproc)" --target voxel_grid_bench k4reg-bench-compare
+compare="$build/bin/k4reg-bench-compare"
+
+machine=$(mktemp)
+trap 'rm -f "$machine"' EXIT
+{
+  echo "### Machine and how to reproduce"
+  echo
+  echo "- Date: $(date -u '+%Y-%m-%d %H:%M UTC') ($mode run)"
+  echo "- CPU: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'), nproc = $(nproc)"
+  echo "- Memory: $(free -g | awk '/^Mem:/ {print $2}') GB; OS: $(. /etc/os-release && echo "$PRETTY_NAME"), kernel $(uname -r)"
+  echo "- Compiler: $(c++ --version | head -1); PCL $(dpkg-query -W -f '${Version}' libpcl-dev 2>/dev/null || echo '?')," \
+       "Google Benchmark $(dpkg-query -W -f '${Version}' libbenchmark-dev 2>/dev/null || echo '?'), Release build"
+  echo "- Source: commit $(git rev-parse --short HEAD)$(git diff --quiet HEAD -- core tools bench 2>/dev/null || echo ' with uncommitted changes in core/, tools/ or bench/')"
+  echo "- Load average when starting: $(cut -d' ' -f1-3 /proc/loadavg) – the machine is shared with other work," \
+       "so absolute times are noisy; compare the columns of one run with each other."
+  echo "- Reproduce: \`bench/run.sh${quick_flag:+ --quick}\` (builds into \`$build\`, runs" \
+       "\`voxel_grid_bench --benchmark_repetitions=5\` and \`k4reg-bench-compare${quick_flag:+ --quick}\`)."
+} > "$machine"
+replace_block "$markdown" machine "$machine"
+
+"$build/bin/voxel_grid_bench" --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
+  --benchmark_out="$results/voxel_grid_bench.json" --benchmark_out_format=json
+"$compare" voxel-report --json "$results/voxel_grid_bench.json" --markdown "$markdown" > /dev/null
+
+"$compare" "${quick_flag[@]}" --cache-dir "$build/bench-cache" --results-dir "$results" --markdown "$markdown" \
+  2>&1 | tee "$results/compare-$mode.log"
+
+if command -v gnuplot > /dev/null; then
+  for plot in "$results"/compare-"$mode"-*.gp; do
+    (cd "$results" && gnuplot "$(basename "$plot")")
+  done
+else
+  echo "gnuplot not found: plots not made" >&2
+fi
+echo "bench/run.sh: done ($mode); see $markdown and $results/"

@@ -1,0 +1,63 @@
+#include "health_command.h"
+
+#include <iostream>
+#include <memory>
+
+#include "channel.h"
+#include "command_error.h"
+#include "grpc/health/v1/health.grpc.pb.h"
+#include "status_text.h"
+
+namespace k4reg::cli {
+namespace {
+
+using grpc::health::v1::HealthCheckRequest;
+using grpc::health::v1::HealthCheckResponse;
+
+struct HealthOptions {
+  ConnectionOptions connection;
+  std::string service;
+  CLI::Option* service_flag = nullptr;  // given: check only that name
+  double deadline_s = 2;                // a probe must answer quickly; a hung server counts as unhealthy
+};
+
+void run_health(const HealthOptions& o) {
+  const std::shared_ptr<grpc::Channel> channel = make_channel(o.connection);
+  auto stub = grpc::health::v1::Health::NewStub(channel);
+  const std::vector<std::string> services = o.service_flag->count() > 0
+                                                ? std::vector<std::string>{o.service}
+                                                : std::vector<std::string>{"liveness", "readiness"};
+  bool all_serving = true;
+  for (const std::string& service : services) {
+    grpc::ClientContext context;
+    add_call_metadata(context, o.connection, "");
+    context.set_deadline(deadline_after(o.deadline_s));
+    HealthCheckRequest request;
+    request.set_service(service);
+    HealthCheckResponse reply;
+    const grpc::Status status = stub->Check(&context, request, &reply);
+    if (!status.ok()) throw CommandError(describe_failure(status, *channel, o.connection.server));
+    std::cout << (service.empty() ? "\"\"" : service) << ": " << HealthCheckResponse::ServingStatus_Name(reply.status())
+              << "\n";
+    all_serving = all_serving && reply.status() == HealthCheckResponse::SERVING;
+  }
+  if (!all_serving) throw CLI::RuntimeError(1);  // exit code 1, nothing more to print
+}
+
+}  // namespace
+
+void add_health_command(CLI::App& app) {
+  auto options = std::make_shared<HealthOptions>();
+  CLI::App* command = app.add_subcommand(
+      "health", "check the server's liveness and readiness; exit code 0 when both are SERVING, 1 otherwise");
+  add_connection_flags(*command, options->connection);
+  options->service_flag = command->add_option(
+      "--service", options->service,
+      "check this one name instead (liveness, readiness, k4reg.v1.Registration, \"\" = the server)");
+  command->add_option("--deadline", options->deadline_s, "seconds to wait for each answer")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  command->callback([options] { run_health(*options); });
+}
+
+}  // namespace k4reg::cli

@@ -1,0 +1,20 @@
+// Core structs <-> k4reg.v1 messages on the client side: the inverse of the server's proto_convert
+// (parameters go out, results come back), kept here so the client links the generated stubs, not the
+// service library.
+#pragma once
+
+#include "k4reg/registration.h"
+#include "k4reg/v1/registration.pb.h"
+#include "registration_flags.h"
+
+namespace k4reg::cli {
+
+// Only the parameters whose flags were given are set; the rest stay unset, so the server's defaults apply
+// (the same values as the local defaults, except threads: the server's --job-threads, not all cores).
+v1::RegistrationParams params_to_proto(const RegistrationParams& params, const RegistrationFlags& flags);
+
+// Throws CommandError for a transform that is not 16 numbers (a server of another API version).
+Eigen::Matrix4d matrix_from_proto(const google::protobuf::RepeatedField<double>& values);
+RegistrationResult result_from_proto(const v1::RegistrationResult& message);
+
+}  // namespace k4reg::cli

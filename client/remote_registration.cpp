@@ -1,0 +1,142 @@
+#include "remote_registration.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <thread>
+#include <vector>
+
+#include "command_error.h"
+#include "crc32c.h"
+#include "local_file.h"
+#include "status_text.h"
+
+namespace k4reg::cli {
+namespace {
+
+using Stream = grpc::ClientReaderWriter<v1::RegisterStreamRequest, v1::RegisterStreamResponse>;
+
+constexpr std::size_t kChunkBytes = 1 << 20;  // the protocol's maximum: fewest messages
+constexpr double kFirstBackoff_s = 1.0;       // gRPC's own reconnect backoff starts at 1 s
+constexpr double kMaxBackoff_s = 16.0;
+
+// Files are read twice, once here for the header's size and CRC-32C and once while sending, so a scan of any
+// size streams through a 1 MiB buffer instead of being held in memory.
+struct LocalFile {
+  std::string path;
+  v1::UploadedFile description;
+};
+
+LocalFile describe_local_file(const std::string& path) {
+  LocalFile file{path, {}};
+  FileReader reader(path, kChunkBytes);
+  Crc32c crc;
+  std::uint64_t size = 0;
+  for (const std::string* piece = &reader.next(); !piece->empty(); piece = &reader.next()) {
+    crc.update(*piece);
+    size += piece->size();
+  }
+  file.description.set_file_name(std::filesystem::path(path).filename().string());  // format hint, no local paths
+  file.description.set_size_bytes(size);
+  file.description.set_crc32c(crc.value());
+  return file;
+}
+
+class Attempt {
+ public:
+  Attempt(v1::Registration::Stub& stub, grpc::ClientContext& context, RegistrationObserver& observer)
+      : context_(context), observer_(observer), stream_(stub.RegisterStream(&context)) {}
+
+  // The call's status; `response` is set when it is OK.
+  grpc::Status run(const v1::UploadHeader& header, const std::vector<std::pair<v1::CloudRole, LocalFile>>& uploads,
+                   v1::RegisterResponse& response) {
+    v1::RegisterStreamRequest message;
+    *message.mutable_header() = header;
+    // A failed Write means the server ended the call (e.g. a refused path): its status says why.
+    bool open = stream_->Write(message);
+    std::uint64_t sent = 0, total = 0;
+    for (const auto& [role, file] : uploads) total += file.description.size_bytes();
+    if (total > 0) observer_.on_upload(0, total);  // starts the clock of the upload rate
+    try {
+      for (const auto& [role, file] : uploads) {
+        FileReader reader(file.path, kChunkBytes);
+        for (const std::string* piece = &reader.next(); open && !piece->empty(); piece = &reader.next()) {
+          v1::RegisterStreamRequest chunk;
+          chunk.mutable_chunk()->set_role(role);
+          chunk.mutable_chunk()->set_data(*piece);
+          open = stream_->Write(chunk);
+          if (!open) break;
+          sent += piece->size();
+          observer_.on_upload(sent, total);
+        }
+      }
+    } catch (const CommandError&) {
+      // A file that became unreadable since it was checksummed: end the call before reporting it.
+      context_.TryCancel();
+      finish(response);
+      throw;
+    }
+    if (open) stream_->WritesDone();
+    return finish(response);
+  }
+
+ private:
+  grpc::Status finish(v1::RegisterResponse& response) {
+    for (v1::RegisterStreamResponse event; stream_->Read(&event);) {
+      if (event.has_result())
+        response = std::move(*event.mutable_result());
+      else
+        observer_.on_event(event);
+    }
+    return stream_->Finish();
+  }
+
+  grpc::ClientContext& context_;
+  RegistrationObserver& observer_;
+  std::unique_ptr<Stream> stream_;
+};
+
+}  // namespace
+
+v1::RegisterResponse register_remote(const std::shared_ptr<grpc::Channel>& channel, const ConnectionOptions& connection,
+                                     const RemoteRegistration& job, const CallPolicy& policy,
+                                     RegistrationObserver& observer) {
+  v1::UploadHeader header;
+  *header.mutable_params() = job.params;
+  std::vector<std::pair<v1::CloudRole, LocalFile>> uploads;
+  if (job.by_reference) {
+    header.mutable_source()->set_path(job.source);
+    header.mutable_target()->set_path(job.target);
+  } else {
+    // Both files are checked before connecting: a typo costs no upload.
+    uploads.emplace_back(v1::CLOUD_ROLE_SOURCE, describe_local_file(job.source));
+    uploads.emplace_back(v1::CLOUD_ROLE_TARGET, describe_local_file(job.target));
+    *header.mutable_source()->mutable_upload() = uploads[0].second.description;
+    *header.mutable_target()->mutable_upload() = uploads[1].second.description;
+  }
+
+  const auto deadline =
+      policy.deadline_s > 0 ? deadline_after(policy.deadline_s) : std::chrono::system_clock::time_point::max();
+  auto stub = v1::Registration::NewStub(channel);
+  const int attempts = 1 + std::max(0, policy.retries);
+  for (int attempt = 1;; ++attempt) {
+    grpc::ClientContext context;
+    add_call_metadata(context, connection, policy.request_id);
+    if (policy.deadline_s > 0) context.set_deadline(deadline);
+    v1::RegisterResponse response;
+    const grpc::Status status = Attempt(*stub, context, observer).run(header, uploads, response);
+    if (status.ok()) {
+      if (!response.has_result()) throw CommandError("INTERNAL: the server ended the call without a result");
+      return response;
+    }
+    const std::string failure = describe_failure(status, *channel, connection.server);
+    const double backoff_s = std::min(kFirstBackoff_s * (1 << std::min(attempt - 1, 8)), kMaxBackoff_s);
+    const auto resume = deadline_after(backoff_s);
+    if (status.error_code() != grpc::StatusCode::UNAVAILABLE || attempt == attempts || resume >= deadline)
+      throw CommandError(failure);
+    observer.on_retry(status_code_name(status.error_code()), backoff_s, attempt + 1, attempts);
+    std::this_thread::sleep_until(resume);
+  }
+}
+
+}  // namespace k4reg::cli

@@ -1,0 +1,99 @@
+// Parts of the k4reg command line that need no server: latency statistics and --server parsing.
+#include <gtest/gtest.h>
+
+#include <numeric>
+#include <stdexcept>
+
+#include "channel.h"
+#include "latency_stats.h"
+#include "progress_bar.h"
+
+namespace k4reg::cli {
+namespace {
+
+std::vector<double> one_to(int n) {
+  std::vector<double> values(n);
+  std::iota(values.begin(), values.end(), 1.0);
+  return values;
+}
+
+TEST(LatencyStats, NearestRankPercentilesOfOneToHundred) {
+  std::vector<double> shuffled = one_to(100);
+  std::reverse(shuffled.begin(), shuffled.end());
+  const LatencySummary s = summarize(shuffled);
+  EXPECT_EQ(s.count, 100u);
+  EXPECT_EQ(s.min, 1);
+  EXPECT_EQ(s.max, 100);
+  EXPECT_DOUBLE_EQ(s.mean, 50.5);
+  EXPECT_EQ(s.p50, 50);
+  EXPECT_EQ(s.p90, 90);
+  EXPECT_EQ(s.p95, 95);
+  EXPECT_EQ(s.p99, 99);
+}
+
+TEST(LatencyStats, PercentilesAreMeasuredValues) {
+  // Ten samples: p99 is the largest (rank ceil(9.9) = 10), p50 the fifth, p90 the ninth.
+  const LatencySummary s = summarize({0.010, 0.020, 0.030, 0.040, 0.050, 0.060, 0.070, 0.080, 0.090, 1.0});
+  EXPECT_EQ(s.p50, 0.050);
+  EXPECT_EQ(s.p90, 0.090);
+  EXPECT_EQ(s.p95, 1.0);
+  EXPECT_EQ(s.p99, 1.0);
+  const std::vector<double> sorted{3.0};
+  EXPECT_EQ(percentile(sorted, 0), 3.0);
+  EXPECT_EQ(percentile(sorted, 100), 3.0);
+}
+
+TEST(LatencyStats, EmptyIsAllZero) {
+  const LatencySummary s = summarize({});
+  EXPECT_EQ(s.count, 0u);
+  EXPECT_EQ(s.p99, 0.0);
+  EXPECT_TRUE(histogram({}, 10).empty());
+}
+
+TEST(LatencyStats, HistogramSpansMinToMaxInEqualBuckets) {
+  const std::vector<HistogramBucket> buckets = histogram(one_to(100), 10);
+  ASSERT_EQ(buckets.size(), 10u);
+  EXPECT_EQ(buckets.front().lower, 1.0);
+  EXPECT_EQ(buckets.back().upper, 100.0);
+  std::size_t total = 0;
+  for (const HistogramBucket& b : buckets) {
+    EXPECT_NEAR(b.upper - b.lower, 9.9, 1e-9);
+    total += b.count;
+  }
+  EXPECT_EQ(total, 100u);
+  EXPECT_EQ(buckets.front().count, 10u);  // 1..10 < 10.9
+  EXPECT_EQ(buckets.back().count, 10u);   // 91..100, the maximum included
+
+  const std::vector<HistogramBucket> same = histogram({2.0, 2.0, 2.0}, 10);
+  ASSERT_EQ(same.size(), 1u);
+  EXPECT_EQ(same[0].count, 3u);
+}
+
+TEST(ChannelTarget, AddressesAndTargets) {
+  EXPECT_EQ(channel_target("127.0.0.1:50051"), "127.0.0.1:50051");
+  EXPECT_EQ(channel_target("scanner-office:50051"), "scanner-office:50051");
+  EXPECT_EQ(channel_target("127.0.0.1:1,127.0.0.1:2"), "ipv4:127.0.0.1:1,127.0.0.1:2");
+  EXPECT_EQ(channel_target("[::1]:1,[::1]:2"), "ipv6:[::1]:1,[::1]:2");
+  EXPECT_EQ(channel_target("dns:///k4reg.example:50051"), "dns:///k4reg.example:50051");
+  EXPECT_EQ(channel_target("ipv4:10.0.0.1:1"), "ipv4:10.0.0.1:1");
+  for (const char* bad : {"", "localhost", "host:", ":50051", "host:0", "host:70000", "host:http", "::1:50051",
+                          "a:1,b:2", "127.0.0.1:1,[::1]:2", "127.0.0.1:1,"})
+    EXPECT_THROW(channel_target(bad), std::invalid_argument) << bad;
+}
+
+TEST(RequestId, IsAVersionFourUuid) {
+  const std::string id = new_request_id();
+  ASSERT_EQ(id.size(), 36u);
+  EXPECT_EQ(id[14], '4');
+  EXPECT_NE(std::string("89ab").find(id[19]), std::string::npos);
+  EXPECT_NE(id, new_request_id());
+}
+
+TEST(HumanBytes, DecimalUnits) {
+  EXPECT_EQ(human_bytes(999), "999 B");
+  EXPECT_EQ(human_bytes(964'600), "964.6 kB");
+  EXPECT_EQ(human_bytes(2.5e9), "2.5 GB");
+}
+
+}  // namespace
+}  // namespace k4reg::cli
