@@ -1,14 +1,15 @@
-// gRPC status codes as the names scripts and people know (OK, RESOURCE_EXHAUSTED, ...), and the one-line
-// message of a failed call.
+// The one-line message of a failed call (status names come from proto/status_name.h).
 #pragma once
 
 #include <grpcpp/grpcpp.h>
 
 #include <string>
 
+#include "status_name.h"
+
 namespace k4reg::cli {
 
-const char* status_code_name(grpc::StatusCode code);
+using k4reg::status_code_name;
 
 // "<CODE>: <message>". A call that failed because no connection could be made (UNAVAILABLE while the channel
 // is not READY) reads "UNAVAILABLE: cannot reach <server> (<gRPC's reason>)": gRPC's own text names resolver
