@@ -22,7 +22,7 @@ EOD
 $d3 << EOD
 50 44.4444 
 EOD
-plot $d0 with linespoints lw 2 pt 7 title 'K-4PCS k4reg 0.7M', \
-     $d1 with linespoints lw 2 pt 7 title 'K-4PCS k4reg 2.5M', \
-     $d2 with linespoints lw 2 pt 7 title 'K-4PCS PCL 0.7M', \
-     $d3 with linespoints lw 2 pt 7 title 'K-4PCS PCL 2.5M'
+plot $d0 with linespoints lw 2 pt 5 ps 1.5 title 'K-4PCS k4reg 0.7M', \
+     $d1 with linespoints lw 2 pt 7 ps 1.5 title 'K-4PCS k4reg 2.5M', \
+     $d2 with linespoints lw 2 pt 9 ps 1.5 title 'K-4PCS PCL 0.7M', \
+     $d3 with linespoints lw 2 pt 11 ps 1.5 title 'K-4PCS PCL 2.5M'

@@ -17,5 +17,5 @@ $d1 << EOD
 0.7 5.95802 4.66047 10.9234 
 2.5 9.93381 8.2348 18.5056 
 EOD
-plot $d0 with yerrorlines lw 2 pt 7 title 'K-4PCS k4reg σ 50 mm', \
-     $d1 with yerrorlines lw 2 pt 7 title 'K-4PCS PCL σ 50 mm'
+plot $d0 with yerrorlines lw 2 pt 5 ps 1.5 title 'K-4PCS k4reg σ 50 mm', \
+     $d1 with yerrorlines lw 2 pt 7 ps 1.5 title 'K-4PCS PCL σ 50 mm'
