@@ -45,23 +45,7 @@ CloudSource RegisterReactor::cloud_source(const v1::CloudInput& input, const cha
 }
 
 void RegisterReactor::execute(Job& job) {
-  clock_.job_start = CallClock::Clock::now();
-  JobReport report;
-  grpc::Status status;
-  try {
-    const RegistrationResult result =
-        run_registration(source_, target_, params_, service_.limits, service_.memory, job.token(), {}, report);
-    result_to_proto(result, reply_->mutable_result());
-  } catch (...) {
-    status = status_from_current_exception();
-  }
-  clock_.job_end = CallClock::Clock::now();
-  record_.source_points = report.source_points;
-  record_.target_points = report.target_points;
-  record_.queue_wait_s = std::chrono::duration<double>(clock_.job_start - clock_.enqueued).count();
-  record_.registration_s = report.registration_s;
-  if (status.ok()) decorate_reply(service_, clock_, report, record_.request_id, *reply_);
-  finish(status);
+  finish(run_job(service_, job, source_, target_, params_, {}, clock_, record_, *reply_));
 }
 
 void RegisterReactor::OnCancel() {

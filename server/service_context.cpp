@@ -1,6 +1,8 @@
 #include "service_context.h"
 
 #include "auth.h"
+#include "proto_convert.h"
+#include "status_mapping.h"
 
 namespace k4reg::service {
 namespace {
@@ -53,6 +55,28 @@ void decorate_reply(const ServiceContext& service, const CallClock& clock, const
   t.set_job_end_to_reply_s(seconds(CallClock::Clock::now() - clock.job_end));
   *reply.mutable_server() = service.server_info;
   reply.set_request_id(request_id);
+}
+
+grpc::Status run_job(const ServiceContext& service, Job& job, const CloudSource& source, const CloudSource& target,
+                     const RegistrationParams& params, const StageListener& listener, CallClock& clock,
+                     RequestRecord& record, v1::RegisterResponse& reply) {
+  clock.job_start = CallClock::Clock::now();
+  JobReport report;
+  grpc::Status status;
+  try {
+    const RegistrationResult result =
+        run_registration(source, target, params, service.limits, service.memory, job.token(), listener, report);
+    result_to_proto(result, reply.mutable_result());
+  } catch (...) {
+    status = status_from_current_exception();
+  }
+  clock.job_end = CallClock::Clock::now();
+  record.source_points = report.source_points;
+  record.target_points = report.target_points;
+  record.queue_wait_s = std::chrono::duration<double>(clock.job_start - clock.enqueued).count();
+  record.registration_s = report.registration_s;
+  if (status.ok()) decorate_reply(service, clock, report, record.request_id, reply);
+  return status;
 }
 
 }  // namespace k4reg::service

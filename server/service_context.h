@@ -13,6 +13,7 @@
 #include "memory_budget.h"
 #include "path_policy.h"
 #include "registration_job.h"
+#include "request_log.h"
 #include "spool.h"
 
 namespace k4reg::service {
@@ -47,5 +48,11 @@ struct CallClock {
 // Fills timings, server info and request id of a successful reply; call just before handing it to gRPC.
 void decorate_reply(const ServiceContext& service, const CallClock& clock, const JobReport& report,
                     const std::string& request_id, v1::RegisterResponse& reply);
+
+// The worker's side of a call, the same for both RPCs: runs the registration, times it on `clock`, notes
+// points and times in `record`, and on success fills and decorates `reply`. Returns the call's status.
+grpc::Status run_job(const ServiceContext& service, Job& job, const CloudSource& source, const CloudSource& target,
+                     const RegistrationParams& params, const StageListener& listener, CallClock& clock,
+                     RequestRecord& record, v1::RegisterResponse& reply);
 
 }  // namespace k4reg::service

@@ -140,29 +140,13 @@ void StreamReactor::read_next_or_start_job() {
 }
 
 void StreamReactor::execute(Job& job) {
-  clock_.job_start = CallClock::Clock::now();
-  JobReport report;
-  grpc::Status status;
+  const StageListener listener = [this](const std::string& stage, v1::StageEvent::Phase phase, double fraction) {
+    post_stage(stage, phase, fraction);
+  };
   v1::RegisterStreamResponse reply;
-  try {
-    const StageListener listener = [this](const std::string& stage, v1::StageEvent::Phase phase, double fraction) {
-      post_stage(stage, phase, fraction);
-    };
-    const RegistrationResult result =
-        run_registration(source_, target_, params_, service_.limits, service_.memory, job.token(), listener, report);
-    result_to_proto(result, reply.mutable_result()->mutable_result());
-  } catch (...) {
-    status = status_from_current_exception();
-  }
-  clock_.job_end = CallClock::Clock::now();
-  record_.source_points = report.source_points;
-  record_.target_points = report.target_points;
-  record_.queue_wait_s = std::chrono::duration<double>(clock_.job_start - clock_.enqueued).count();
-  record_.registration_s = report.registration_s;
-  if (status.ok()) {
-    decorate_reply(service_, clock_, report, record_.request_id, *reply.mutable_result());
-    post(std::move(reply));
-  }
+  const grpc::Status status =
+      run_job(service_, job, source_, target_, params_, listener, clock_, record_, *reply.mutable_result());
+  if (status.ok()) post(std::move(reply));
   finish(status);
 }
 

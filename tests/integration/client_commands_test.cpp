@@ -32,15 +32,7 @@ CommandRun k4reg(const std::vector<std::string>& args, const std::map<std::strin
   const fs::path out = dir.path() / "out", err = dir.path() / "err";
   std::vector<std::string> arguments{K4REG_BIN_DIR "/k4reg"};
   arguments.insert(arguments.end(), args.begin(), args.end());
-  std::vector<std::string> environment;
-  for (char** e = environ; *e; ++e)
-    if (std::string_view(*e).rfind("K4REG_", 0) != 0) environment.emplace_back(*e);
-  for (const auto& [name, value] : env) environment.push_back(name + "=" + value);
-  std::vector<char*> argv, envp;
-  for (std::string& a : arguments) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  for (std::string& e : environment) envp.push_back(e.data());
-  envp.push_back(nullptr);
+  ExecVectors exec = exec_vectors(std::move(arguments), env);
 
   const pid_t pid = fork();
   if (pid == 0) {
@@ -48,7 +40,7 @@ CommandRun k4reg(const std::vector<std::string>& args, const std::map<std::strin
     const int err_fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(out_fd, STDOUT_FILENO);
     dup2(err_fd, STDERR_FILENO);
-    execve(argv[0], argv.data(), envp.data());
+    execve(exec.argv[0], exec.argv.data(), exec.envp.data());
     _exit(127);
   }
   int status = 0;

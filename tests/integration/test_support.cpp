@@ -45,27 +45,30 @@ TempDir::~TempDir() {
   fs::remove_all(path_, ec);
 }
 
+ExecVectors exec_vectors(std::vector<std::string> arguments, const std::map<std::string, std::string>& env) {
+  ExecVectors exec;
+  exec.arguments = std::move(arguments);
+  for (char** e = environ; *e; ++e)
+    if (std::string_view(*e).rfind("K4REG_", 0) != 0) exec.environment.emplace_back(*e);
+  for (const auto& [name, value] : env) exec.environment.push_back(name + "=" + value);
+  for (std::string& a : exec.arguments) exec.argv.push_back(a.data());
+  exec.argv.push_back(nullptr);
+  for (std::string& e : exec.environment) exec.envp.push_back(e.data());
+  exec.envp.push_back(nullptr);
+  return exec;
+}
+
 ServerProcess::ServerProcess(const std::vector<std::string>& args, const std::map<std::string, std::string>& env) {
   const fs::path port_file = work_.path() / "port", log_file = work_.path() / "server.log";
   std::vector<std::string> arguments{K4REG_BIN_DIR "/k4reg-server", "--grpc-listen", "127.0.0.1:0",
                                      "--port-file", port_file.string(), "--spool-dir", (work_.path() / "spool").string()};
   arguments.insert(arguments.end(), args.begin(), args.end());
-  // The caller's K4REG_* variables must not leak into the server under test.
-  std::vector<std::string> environment;
-  for (char** e = environ; *e; ++e)
-    if (std::string_view(*e).rfind("K4REG_", 0) != 0) environment.emplace_back(*e);
-  for (const auto& [name, value] : env) environment.push_back(name + "=" + value);
-
-  std::vector<char*> argv, envp;
-  for (std::string& a : arguments) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  for (std::string& e : environment) envp.push_back(e.data());
-  envp.push_back(nullptr);
+  ExecVectors exec = exec_vectors(std::move(arguments), env);
   const int log_fd = ::open(log_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   pid_ = fork();
   if (pid_ == 0) {
     dup2(log_fd, STDERR_FILENO);
-    execve(argv[0], argv.data(), envp.data());
+    execve(exec.argv[0], exec.argv.data(), exec.envp.data());
     _exit(127);
   }
   ::close(log_fd);

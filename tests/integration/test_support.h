@@ -23,6 +23,14 @@ namespace k4reg::test {
 namespace fs = std::filesystem;
 
 fs::path bunny_dir();
+
+// argv and envp for execve: `arguments`, and the caller's environment less its K4REG_* variables (they must not
+// leak into the program under test) plus `env`. argv/envp point into the strings held alongside them.
+struct ExecVectors {
+  std::vector<std::string> arguments, environment;
+  std::vector<char*> argv, envp;
+};
+ExecVectors exec_vectors(std::vector<std::string> arguments, const std::map<std::string, std::string>& env);
 std::string read_file(const fs::path& path);
 void write_file(const fs::path& path, const std::string& bytes);
 
