@@ -8,7 +8,7 @@
 #include <future>
 #include <thread>
 
-#include "crc32c.h"
+#include "k4reg/crc32c.h"
 #include "job_queue.h"
 #include "k4reg/error.h"
 #include "memory_budget.h"

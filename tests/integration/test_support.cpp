@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "crc32c.h"
+#include "k4reg/crc32c.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "k4reg/gt_pairs.h"
 

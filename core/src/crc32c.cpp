@@ -1,4 +1,4 @@
-#include "crc32c.h"
+#include "k4reg/crc32c.h"
 
 #include <array>
 #include <bit>
