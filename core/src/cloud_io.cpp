@@ -148,7 +148,7 @@ void split_fields(std::string_view line, std::vector<std::string_view>& tokens) 
   tokens.clear();
   std::size_t i = 0, n = line.size();
   auto is_sep = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == ',' || c == ';' || c == '\f' || c == '\v'; };
-  while (i < n) {
+  while (i < n && tokens.size() <= kMaxTokensPerLine) {
     while (i < n && is_sep(line[i])) ++i;
     if (i >= n) break;
     std::size_t start = i;

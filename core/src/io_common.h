@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <bit>
 #include <charconv>
 #include <cstdint>
 #include <cstdio>
@@ -16,6 +17,12 @@
 #include "k4reg/point_cloud.h"
 
 namespace k4reg::io_detail {
+
+// Limits far above any real file, so that a hostile header or line cannot make a reader allocate more than a
+// small multiple of the file's size: tokens on one line (text columns, PCD header values) and header entries
+// (PLY elements, PLY properties per element).
+constexpr std::size_t kMaxTokensPerLine = 1024;
+constexpr std::size_t kMaxHeaderEntries = 1024;
 
 // Throws k4reg::Error(code, "<name>: <message>").
 [[noreturn]] void fail_io(ErrorCode code, const std::string& name, const std::string& message);
@@ -58,6 +65,14 @@ inline bool mul_fits(std::uint64_t a, std::uint64_t b, std::uint64_t limit) {
 // World coordinate of point i, in double.
 inline Eigen::Vector3d world_point(const PointCloud& cloud, std::size_t i) {
   return cloud.origin_m + cloud.points[i].cast<double>();
+}
+
+// Scan formats with an intensity field (LAS, PTX, E57) often fill it with one value when the scanner recorded
+// none (LAS: 0, PTX: 0.5); a constant carries no signal for keypoints, so it is dropped.
+inline void drop_constant_intensity(std::vector<float>& intensity) {
+  for (float value : intensity)
+    if (value != intensity.front()) return;
+  intensity.clear();
 }
 
 // Validates a cloud before writing (intensity size) and returns whether intensity is written.
@@ -131,6 +146,28 @@ inline T byteswap_value(T value) {
   return value;
 }
 
+// Little-endian fields of binary formats (LAS, E57), whatever the host's byte order.
+template <typename T>
+inline T load_le(const char* p) {
+  T value;
+  std::memcpy(&value, p, sizeof(T));
+  if constexpr (std::endian::native == std::endian::big) value = byteswap_value(value);
+  return value;
+}
+
+template <typename T>
+inline void store_le(char* p, T value) {
+  if constexpr (std::endian::native == std::endian::big) value = byteswap_value(value);
+  std::memcpy(p, &value, sizeof(T));
+}
+
+template <typename T>
+inline void append_le(std::string& out, T value) {
+  char bytes[sizeof(T)];
+  store_le(bytes, value);
+  out.append(bytes, sizeof(T));
+}
+
 // Splits text into lines; `\r\n` and `\n` endings; the last line may lack a newline.
 class LineReader {
  public:
@@ -190,7 +227,8 @@ class TokenReader {
 };
 
 // Splits a line into whitespace/comma-separated tokens (empty tokens between commas are errors reported by
-// the caller as non-numeric). Returns the number of tokens written to `tokens` (clears it first).
+// the caller as non-numeric), clearing `tokens` first. Stops after kMaxTokensPerLine + 1 tokens: callers refuse
+// longer lines (tokens.size() > kMaxTokensPerLine) without holding a token per byte.
 void split_fields(std::string_view line, std::vector<std::string_view>& tokens);
 
 // Quotes a token for an error message, shortened to a readable length.

@@ -173,6 +173,9 @@ PcdHeader parse_header(std::string_view data, const std::string& name) {
     line.remove_prefix(p);
     if (line.front() == '#') continue;
     std::vector<std::string_view> tok = split_ws(line);
+    if (tok.size() > io_detail::kMaxTokensPerLine)
+      fail_io(ErrorCode::kInvalidArgument, name,
+              where + "more than " + std::to_string(io_detail::kMaxTokensPerLine) + " fields or values on one line");
     const std::string_view key = tok[0];
     auto values = [&]() { return std::vector<std::string_view>(tok.begin() + 1, tok.end()); };
     auto one_uint = [&](std::uint64_t& v) {

@@ -93,7 +93,7 @@ std::vector<std::string_view> split_ws(std::string_view line) {
   std::vector<std::string_view> out;
   std::size_t i = 0;
   auto ws = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; };
-  while (i < line.size()) {
+  while (i < line.size() && out.size() <= io_detail::kMaxTokensPerLine) {  // longer lines are malformed anyway
     while (i < line.size() && ws(line[i])) ++i;
     if (i >= line.size()) break;
     std::size_t start = i;
@@ -146,11 +146,18 @@ PlyHeader parse_header(std::string_view data, const std::string& name) {
         fail_io(ErrorCode::kInvalidArgument, name,
                 where + "element count " + io_detail::quote(tok[2]) + " is not a non-negative integer");
       element.header_line = ln;
+      if (header.elements.size() == io_detail::kMaxHeaderEntries)
+        fail_io(ErrorCode::kInvalidArgument, name,
+                where + "more than " + std::to_string(io_detail::kMaxHeaderEntries) + " elements");
       header.elements.push_back(std::move(element));
     } else if (key == "property") {
       if (header.elements.empty())
         fail_io(ErrorCode::kInvalidArgument, name, where + "property before any element");
       PlyElement& element = header.elements.back();
+      if (element.properties.size() == io_detail::kMaxHeaderEntries)
+        fail_io(ErrorCode::kInvalidArgument, name,
+                where + "element '" + element.name + "' has more than " +
+                    std::to_string(io_detail::kMaxHeaderEntries) + " properties");
       PlyProperty prop;
       if (tok.size() >= 2 && tok[1] == "list") {
         if (tok.size() != 5) fail_io(ErrorCode::kInvalidArgument, name, where + "malformed list property");

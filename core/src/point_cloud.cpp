@@ -6,6 +6,13 @@
 #include "k4reg/error.h"
 
 namespace k4reg {
+namespace {
+
+// Beyond any position on Earth in any unit down to millimetres; keeps the bounding-box centre and the float
+// offsets from it finite.
+constexpr double kMaxAbsCoordinate = 1e12;
+
+}  // namespace
 
 PointCloud make_local_cloud(const std::vector<Eigen::Vector3d>& points_world, std::vector<float> intensity,
                             const char* what) {
@@ -16,6 +23,9 @@ PointCloud make_local_cloud(const std::vector<Eigen::Vector3d>& points_world, st
     const Eigen::Vector3d& p = points_world[i];
     if (!p.allFinite())
       fail(ErrorCode::kInvalidArgument, std::string(what) + ": point " + std::to_string(i) + " has a NaN/Inf coordinate");
+    if (p.cwiseAbs().maxCoeff() > kMaxAbsCoordinate)
+      fail(ErrorCode::kInvalidArgument, std::string(what) + ": point " + std::to_string(i) +
+                                            " has a coordinate beyond +-1e12, not a position in any unit");
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }

@@ -38,8 +38,13 @@ std::uint64_t pack_voxel_key(const Eigen::Vector3i& index) {
 }
 
 Eigen::Vector3i voxel_index(const Eigen::Vector3f& p, float inv_voxel) {
-  return Eigen::Vector3i(static_cast<int>(std::floor(p.x() * inv_voxel)), static_cast<int>(std::floor(p.y() * inv_voxel)),
-                         static_cast<int>(std::floor(p.z() * inv_voxel)));
+  // Saturated before the conversion (an out-of-range float -> int conversion is undefined and wraps in practice):
+  // far points get indices beyond kAxisLimit, which voxel_grid() refuses. NaN saturates too.
+  constexpr float kSaturation = 1 << 30;
+  auto axis = [inv_voxel](float v) {
+    return static_cast<int>(std::fmax(-kSaturation, std::fmin(kSaturation, std::floor(v * inv_voxel))));
+  };
+  return Eigen::Vector3i(axis(p.x()), axis(p.y()), axis(p.z()));
 }
 
 VoxelizedCloud voxel_grid(const PointCloud& cloud, double voxel_m, const CancellationToken* cancel) {

@@ -31,6 +31,9 @@ PointCloud read_xyz_bytes(std::string_view data, const std::string& name, const 
     if (line.front() == '#' || line.substr(0, 2) == "//") continue;
     io_detail::split_fields(line, tokens);
     if (tokens.empty()) continue;  // a line of separators only
+    if (tokens.size() > io_detail::kMaxTokensPerLine)
+      fail_io(ErrorCode::kInvalidArgument, name,
+              "line " + std::to_string(ln) + ": more than " + std::to_string(io_detail::kMaxTokensPerLine) + " columns");
     std::uint64_t count_line;
     if (tokens.size() == 1 && io_detail::parse_uint64(tokens[0], count_line)) {  // PTS point count
       seen_content = true;

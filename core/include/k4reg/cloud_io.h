@@ -4,7 +4,9 @@
 // parses coordinates in double precision and builds the cloud with make_local_cloud() (survey coordinates
 // are shifted to a local origin before anything becomes float). Every problem — missing file, empty file,
 // wrong magic, malformed/truncated header or body, NaN/Inf coordinates, no points — is a k4reg::Error whose
-// message starts with the file name ("scan.ply: truncated: …"). Readers never crash on hostile input.
+// message starts with the file name ("scan.ply: truncated: …"). Readers never crash on hostile input, and their
+// memory stays a small multiple of the file's size whatever a header claims (io_common.h: kMaxTokensPerLine,
+// kMaxHeaderEntries).
 //
 // Error codes: kNotFound (file missing), kInvalidArgument (malformed / truncated / empty / NaN / 0 points),
 // kResourceExhausted (more points than ReadOptions::max_points; refused before allocating),

@@ -21,7 +21,8 @@ struct PointCloud {
 };
 
 // Builds a cloud from double-precision coordinates: picks a local origin (rounded centre of the
-// bounding box) and stores float offsets from it. Throws kInvalidArgument on NaN/Inf.
+// bounding box) and stores float offsets from it. Throws kInvalidArgument on NaN/Inf and on coordinates
+// beyond +-1e12 (whose offsets would not fit a float).
 PointCloud make_local_cloud(const std::vector<Eigen::Vector3d>& points_world, std::vector<float> intensity,
                             const char* what = "cloud");
 
