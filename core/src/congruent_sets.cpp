@@ -139,6 +139,7 @@ void find_congruent_sets(const Base& base, const std::vector<Eigen::Vector3f>& t
     for (int b = 0; b < 2; ++b) edge[2 * a + b] = (base.point[a] - base.point[2 + b]).norm();
   const float edge_tolerance = static_cast<float>(tolerance.edge_m);
   const float coincidence = static_cast<float>(tolerance.coincidence_m);
+  const PairIndex::Pair* const diagonal1 = first1;  // a lambda cannot capture a structured binding before clang 16
 
   for (const auto* p = first2; p != last2; ++p) {
     for (int direction = 0; direction < 2; ++direction) {
@@ -147,7 +148,7 @@ void find_congruent_sets(const Base& base, const std::vector<Eigen::Vector3f>& t
       const Eigen::Vector3f& ql = target[l];
       const Eigen::Vector3f crossing = qk + base.r2 * (ql - qk);
       grid.for_each_within(crossing, coincidence, [&](std::uint32_t c, float) {
-        const auto* pair1 = first1 + c / 2;
+        const auto* pair1 = diagonal1 + c / 2;
         const std::uint32_t i = (c & 1) ? pair1->j : pair1->i, j = (c & 1) ? pair1->i : pair1->j;
         if (i == k || i == l || j == k || j == l) return;
         const Eigen::Vector3f &qi = target[i], &qj = target[j];

@@ -173,6 +173,7 @@ PcdHeader parse_header(std::string_view data, const std::string& name) {
     line.remove_prefix(p);
     if (line.front() == '#') continue;
     std::vector<std::string_view> tok = split_ws(line);
+    if (tok.empty()) continue;  // separators only (",", "\v", ...)
     if (tok.size() > io_detail::kMaxTokensPerLine)
       fail_io(ErrorCode::kInvalidArgument, name,
               where + "more than " + std::to_string(io_detail::kMaxTokensPerLine) + " fields or values on one line");

@@ -118,9 +118,12 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
   const double sigma = params.min_scale_m;
 
   // 1. Voxel grid at the minimum scale (paper Sec. 2.1).
-  const auto [source_voxels, target_voxels] = timer.run("voxel_grid", [&] {
+  // Named references rather than structured bindings: lambdas below use them, and clang < 16 cannot capture
+  // a structured binding.
+  const auto voxelised = timer.run("voxel_grid", [&] {
     return std::make_pair(voxel_grid(source, sigma, cancel), voxel_grid(target, sigma, cancel));
   });
+  const VoxelizedCloud &source_voxels = voxelised.first, &target_voxels = voxelised.second;
   result.source_voxels = source_voxels.cloud.size();
   result.target_voxels = target_voxels.cloud.size();
   check_geometry(source_voxels.cloud.points, sigma, "source");
@@ -178,10 +181,11 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
   IcpParams icp_params;
   icp_params.voxel_m = sigma;
   icp_params.max_iterations = params.icp_max_iterations;
-  const auto [source_pyramid, target_pyramid] = timer.run("icp_setup", [&] {
+  const auto pyramids = timer.run("icp_setup", [&] {
     return std::make_pair(make_icp_pyramid(source_voxels.cloud.points, icp_params, false, cancel),
                           make_icp_pyramid(target_voxels.cloud.points, icp_params, true, cancel));
   });
+  const auto &source_pyramid = pyramids.first, &target_pyramid = pyramids.second;
   const SymmetryGuardResult guarded = timer.run("symmetry_guard", [&] {
     return rank_hypotheses(source_pyramid, target_pyramid, matched.hypotheses, free_space ? &*free_space : nullptr,
                            cancel);

@@ -265,6 +265,7 @@ TEST(HostileInput, Pcd) {
       {"1 MiB field name", "scan.pcd",
        "VERSION 0.7\nFIELDS " + std::string(1 << 20, 'x') + "\nSIZE 4\nTYPE F\nPOINTS 1\nDATA ascii\n1\n",
        ErrorCode::kInvalidArgument, "'x'"},
+      {"header lines of separators only", "scan.pcd", ",\n\v;\n" + head, ErrorCode::kInvalidArgument, "DATA"},
       {"1 MiB header without DATA", "scan.pcd", head + repeat("# comment\n", 100000), ErrorCode::kInvalidArgument,
        "DATA"},
       {"only NaN points", "scan.pcd", head + "POINTS 2\nDATA binary\n" + nan_body, ErrorCode::kInvalidArgument,
