@@ -14,9 +14,12 @@
 #include <cstring>
 
 #include "io_common.h"
+#include "k4reg/e57_io.h"
 #include "k4reg/error.h"
+#include "k4reg/las_io.h"
 #include "k4reg/pcd_io.h"
 #include "k4reg/ply_io.h"
+#include "k4reg/ptx_io.h"
 #include "k4reg/xyz_io.h"
 
 namespace k4reg {
@@ -247,6 +250,12 @@ const char* to_string(CloudFormat format) {
       return "PCD";
     case CloudFormat::kXyz:
       return "XYZ";
+    case CloudFormat::kLas:
+      return "LAS";
+    case CloudFormat::kPtx:
+      return "PTX";
+    case CloudFormat::kE57:
+      return "E57";
   }
   return "unknown";
 }
@@ -261,6 +270,12 @@ bool extension_format(const std::string& path, CloudFormat& format) {
     format = CloudFormat::kPcd;
   } else if (ext == ".xyz" || ext == ".txt" || ext == ".pts" || ext == ".csv" || ext == ".asc") {
     format = CloudFormat::kXyz;
+  } else if (ext == ".las" || ext == ".laz") {  // the LAS reader refuses compressed (LAZ) content
+    format = CloudFormat::kLas;
+  } else if (ext == ".ptx") {
+    format = CloudFormat::kPtx;
+  } else if (ext == ".e57") {
+    format = CloudFormat::kE57;
   } else {
     return false;
   }
@@ -311,10 +326,12 @@ bool looks_like_numeric_text(std::string_view data) {
 
 CloudFormat format_from_extension(const std::string& path) {
   CloudFormat format;
+  if (io_detail::lower_extension(path) == ".laz")
+    fail_io(ErrorCode::kInvalidArgument, path, "LAZ is not supported; decompress with laszip or pdal first");
   if (!extension_format(path, format))
     fail_io(ErrorCode::kInvalidArgument, path,
             "unknown point-cloud extension '" + io_detail::lower_extension(path) +
-                "' (supported: .ply, .pcd, .xyz, .txt, .csv, .pts)");
+                "' (supported: .ply, .pcd, .xyz, .txt, .csv, .pts, .asc, .las, .ptx, .e57)");
   return format;
 }
 
@@ -322,7 +339,10 @@ CloudFormat detect_format_bytes(std::string_view data, const std::string& name) 
   std::string_view body = data;
   if (starts_with(body, "\xEF\xBB\xBF")) body.remove_prefix(3);  // UTF-8 BOM
   if (starts_with(body, "ply\n") || starts_with(body, "ply\r\n")) return CloudFormat::kPly;
+  if (starts_with(data, "LASF")) return CloudFormat::kLas;
+  if (starts_with(data, "ASTM-E57")) return CloudFormat::kE57;
   if (looks_like_pcd(body)) return CloudFormat::kPcd;
+  if (looks_like_ptx(body)) return CloudFormat::kPtx;  // before XYZ: a PTX header is numeric text too
   CloudFormat by_extension;
   const bool has_extension = extension_format(name, by_extension);
   // A .ply/.pcd file without its magic goes to its own reader, which names the problem ("wrong magic").
@@ -331,7 +351,7 @@ CloudFormat detect_format_bytes(std::string_view data, const std::string& name) 
   if (has_extension) return by_extension;
   if (data.empty()) fail_io(ErrorCode::kInvalidArgument, name, "empty file");
   fail_io(ErrorCode::kInvalidArgument, name,
-          "cannot determine the point-cloud format: not PLY, not PCD and not numeric text");
+          "cannot determine the point-cloud format: not PLY, LAS, E57, PCD, PTX or numeric text");
 }
 
 CloudFormat detect_format(const std::string& path) {
@@ -340,13 +360,23 @@ CloudFormat detect_format(const std::string& path) {
 }
 
 PointCloud read_cloud_bytes(std::string_view data, const std::string& name, const ReadOptions& options) {
-  switch (detect_format_bytes(data, name)) {
+  const CloudFormat format = detect_format_bytes(data, name);
+  if ((options.scan_index || !options.scan_name.empty()) && format != CloudFormat::kE57 && format != CloudFormat::kPtx)
+    fail_io(ErrorCode::kInvalidArgument, name,
+            std::string("a ") + to_string(format) + " file holds one scan; scan selection applies to E57 and PTX files");
+  switch (format) {
     case CloudFormat::kPly:
       return read_ply_bytes(data, name, options);
     case CloudFormat::kPcd:
       return read_pcd_bytes(data, name, options);
     case CloudFormat::kXyz:
       return read_xyz_bytes(data, name, options);
+    case CloudFormat::kLas:
+      return read_las_bytes(data, name, options);
+    case CloudFormat::kPtx:
+      return read_ptx_bytes(data, name, options);
+    case CloudFormat::kE57:
+      return read_e57_bytes(data, name, options);
   }
   fail_io(ErrorCode::kInternal, name, "unhandled cloud format");
 }
@@ -368,6 +398,19 @@ void write_cloud(const std::string& path, const PointCloud& cloud) {
     case CloudFormat::kXyz:
       write_xyz(path, cloud, ext == ".csv" ? XyzStyle::kComma : ext == ".pts" ? XyzStyle::kPtsCount : XyzStyle::kSpace);
       return;
+    case CloudFormat::kLas:
+      write_las(path, cloud);
+      return;
+    case CloudFormat::kPtx:
+      write_ptx(path, {PtxScan{cloud}});
+      return;
+    case CloudFormat::kE57: {
+      E57Scan scan;
+      scan.name = "scan";
+      scan.cloud = cloud;
+      write_e57(path, {scan});
+      return;
+    }
   }
 }
 

@@ -89,6 +89,12 @@ class OutputFile {
 
   void write(const void* data, std::size_t size);
   void write(std::string_view text) { write(text.data(), text.size()); }
+  // Writes and clears `text` once it holds more than 64 KiB: text writers append lines to it and call this.
+  void write_batched(std::string& text) {
+    if (text.size() <= (1u << 16)) return;
+    write(text);
+    text.clear();
+  }
   void commit();
 
  private:

@@ -122,10 +122,7 @@ void write_xyz(const std::string& path, const PointCloud& cloud, XyzStyle style)
       io_detail::append_number(text, cloud.intensity[i]);
     }
     text += '\n';
-    if (text.size() > (1u << 16)) {
-      out.write(text);
-      text.clear();
-    }
+    out.write_batched(text);
   }
   out.write(text);
   out.commit();

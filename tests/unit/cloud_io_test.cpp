@@ -190,7 +190,7 @@ TEST_F(CloudIoTest, WriteCloudPicksFormatFromExtension) {
   std::size_t files = 0;
   for (const auto& entry : fs::directory_iterator(dir_)) files += entry.is_regular_file();
   EXPECT_EQ(files, std::size(cases));
-  expect_error([&] { write_cloud(path("a.las"), c); }, ErrorCode::kInvalidArgument, "a.las", "extension");
+  expect_error([&] { write_cloud(path("a.obj"), c); }, ErrorCode::kInvalidArgument, "a.obj", "extension");
   expect_error([&] { write_cloud(path("nodir/a.ply"), c); }, ErrorCode::kNotFound, "a.ply");
 }
 
