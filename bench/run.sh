@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # bench/run.sh [--quick]
-# Builds the benchmarks, runs the voxel grid benchmark (Google Benchmark, 5 repetitions, medians) and the
-# K-4PCS / 4PCS comparison with PCL 1.13, then rewrites the machine, voxel and compare blocks of
-# bench/RESULTS.md and the files in bench/results/ (CSV, JSON, gnuplot scripts, PNG plots, run log).
+# Builds the benchmarks, runs the voxel grid benchmark (Google Benchmark, 5 repetitions, medians), the read
+# throughput of every scan format (k4reg-bench-read, 10 M points, about half a minute) and the K-4PCS / 4PCS
+# comparison with PCL 1.13, then rewrites the machine, voxel, read and compare blocks of bench/RESULTS.md and the
+# files in bench/results/ (CSV, JSON, gnuplot scripts, PNG plots, run log).
 # --quick: a representative subset (about 20 min on 2 cores). Without it: the full suites (hours).
 # Not part of the test suite. Build directory: $K4REG_BENCH_BUILD_DIR (default build-bench).
 set -euo pipefail
@@ -38,7 +39,7 @@ replace_block() {
 
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DK4REG_BUILD_BENCH=ON -DK4REG_BUILD_SERVICE=OFF \
   -DK4REG_BUILD_TESTS=OFF > /dev/null
-cmake --build "$build" -j"$(nproc)" --target voxel_grid_bench k4reg-bench-compare
+cmake --build "$build" -j"$(nproc)" --target voxel_grid_bench k4reg-bench-compare k4reg-bench-read
 compare="$build/bin/k4reg-bench-compare"
 
 machine=$(mktemp)
@@ -55,9 +56,21 @@ trap 'rm -f "$machine"' EXIT
   echo "- Load average when starting: $(cut -d' ' -f1-3 /proc/loadavg) – the machine is shared with other work," \
        "so absolute times are noisy; compare the columns of one run with each other."
   echo "- Reproduce: \`bench/run.sh${quick_flag:+ --quick}\` (builds into \`$build\`, runs" \
-       "\`voxel_grid_bench --benchmark_repetitions=5\` and \`k4reg-bench-compare${quick_flag:+ --quick}\`)."
+       "\`voxel_grid_bench --benchmark_repetitions=5\`, \`k4reg-bench-read\` and \`k4reg-bench-compare${quick_flag:+ --quick}\`)."
 } > "$machine"
 replace_block "$markdown" machine "$machine"
+
+read_table=$(mktemp)
+trap 'rm -f "$machine" "$read_table"' EXIT
+{
+  echo "### Read throughput: one 10 M-point cloud in every format"
+  echo
+  echo "Random points with intensity in a 200 m block at 500 000 E / 5 240 000 N, written by the core's writers, read"
+  echo "with \`read_cloud\` from the page cache (median of 3 after one warm-up read; load average $(cut -d' ' -f1 /proc/loadavg))."
+  echo
+  "$build/bin/k4reg-bench-read" --repeats 3
+} > "$read_table"
+replace_block "$markdown" read "$read_table"
 
 "$build/bin/voxel_grid_bench" --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
   --benchmark_out="$results/voxel_grid_bench.json" --benchmark_out_format=json
