@@ -34,12 +34,14 @@ int FreeSpaceImage::cell(const Eigen::Vector3f& u) const {
   return e * kAzimuthCells + a;
 }
 
-bool FreeSpaceImage::contradicts(const Eigen::Vector3f& q) const {
+FreeSpaceImage::Seen FreeSpaceImage::classify(const Eigen::Vector3f& q) const {
   const Eigen::Vector3f d = q - scanner_;
   const float range = d.norm();
-  if (range <= margin_) return false;
+  if (range <= margin_) return Seen::kUnknown;
   const float nearest = nearest_[cell(d / range)];
-  return std::isfinite(nearest) && range < nearest - margin_;  // no return there: nothing is known
+  if (!std::isfinite(nearest)) return Seen::kUnknown;
+  if (range < nearest - margin_) return Seen::kEmpty;
+  return range <= nearest + margin_ ? Seen::kSurface : Seen::kOccluded;
 }
 
 double FreeSpaceImage::median_range_m(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& scanner_m) {

@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "k4reg/neighbor_grid.h"
@@ -110,7 +111,8 @@ IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const E
                      const IcpParams& params, const CancellationToken* cancel) {
   IcpResult result;
   result.transform = initial;
-  const std::size_t stages = std::min(source.stages.size(), target.stages.size());
+  const std::size_t stages =
+      std::min({static_cast<std::size_t>(std::max(params.stages, 1)), source.stages.size(), target.stages.size()});
   for (std::size_t stage = 0; stage < stages; ++stage) {
     const auto& src = source.stages[stage];
     const auto& tgt = target.stages[stage];

@@ -1,5 +1,8 @@
 #include "k4reg/symmetry_guard.h"
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 
@@ -11,18 +14,65 @@
 namespace k4reg {
 namespace {
 
+// Without free space: the share of source points with a target point within tau. With the target's
+// free space, points the target scanner could not have seen (behind its first return, or where it got
+// no return) and did not match are no evidence either way; counting them as misses favours the pose
+// that maps one scanner's occlusion shadows onto the other's — in a symmetric room, the flip. So the
+// score is, of the points with evidence, the share matched less the share the target saw through.
 double cloud_score(const std::vector<Eigen::Vector3f>& source, const NeighborGrid& grid, float tau,
                    const Eigen::Matrix4d& t, const FreeSpaceImage* free_space) {
   const Eigen::Affine3f a = to_affine3f(t);
-  std::size_t hits = 0, contradicted = 0;
+  std::size_t hits = 0, contradicted = 0, unseen = 0;
   for (const Eigen::Vector3f& p : source) {
     const Eigen::Vector3f q = a * p;
-    if (grid.any_within(q, tau))
+    if (grid.any_within(q, tau)) {
       ++hits;
-    else if (free_space && free_space->contradicts(q))
-      ++contradicted;
+      continue;
+    }
+    if (!free_space) continue;
+    const FreeSpaceImage::Seen seen = free_space->classify(q);
+    if (seen == FreeSpaceImage::Seen::kEmpty) ++contradicted;
+    if (seen == FreeSpaceImage::Seen::kOccluded || seen == FreeSpaceImage::Seen::kUnknown) ++unseen;
   }
-  return (static_cast<double>(hits) - static_cast<double>(contradicted)) / std::max<std::size_t>(1, source.size());
+  // A floor of 5 % of the points keeps poses that put nearly everything out of sight from scoring high.
+  const double evidence = std::max(static_cast<double>(source.size() - unseen), 0.05 * source.size());
+  return (static_cast<double>(hits) - static_cast<double>(contradicted)) / std::max(1.0, evidence);
+}
+
+// Centre of the middle 90 % of the points per axis: a room scan's stray points through windows and
+// doors must not pull it, and unlike the centroid it does not follow the scanner's dense near field.
+Eigen::Vector3f trimmed_centre(const std::vector<Eigen::Vector3f>& points) {
+  Eigen::Vector3f centre;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<float> values(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) values[i] = points[i](axis);
+    const std::size_t low = values.size() / 20, high = values.size() - 1 - values.size() / 20;
+    std::nth_element(values.begin(), values.begin() + low, values.end());
+    const float a = values[low];
+    std::nth_element(values.begin(), values.begin() + high, values.end());
+    centre(axis) = 0.5f * (a + values[high]);
+  }
+  return centre;
+}
+
+// Half-turns about the target's principal axes through its centre: a rectangular room's shell looks
+// the same after a half turn about the vertical (and nearly so about the other two axes), so a pose
+// composed with one of them is where 4PCS's symmetric twin of the true pose lies. As target -> target maps.
+std::vector<Eigen::Matrix4d> principal_half_turns(const std::vector<Eigen::Vector3f>& points) {
+  if (points.size() < 10) return {};
+  const Eigen::Vector3d centre = trimmed_centre(points).cast<double>();
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3f& p : points) cov += (p.cast<double>() - centre) * (p.cast<double>() - centre).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
+  std::vector<Eigen::Matrix4d> turns;
+  for (int axis = 0; axis < 3; ++axis) {
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(M_PI, solver.eigenvectors().col(axis).normalized()).toRotationMatrix();
+    Eigen::Matrix4d s = Eigen::Matrix4d::Identity();
+    s.topLeftCorner<3, 3>() = r;
+    s.topRightCorner<3, 1>() = centre - r * centre;
+    turns.push_back(s);
+  }
+  return turns;
 }
 
 }  // namespace
@@ -39,12 +89,29 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   IcpParams quick;
   quick.stages = kStages;
   quick.max_iterations = kIterations;
-  for (Hypothesis& h : hypotheses) {
+  auto settle = [&](Hypothesis& h) {
     h.transform = refine_icp(source, target, h.transform, quick, cancel).transform;
     h.cloud_score = cloud_score(scored.points, grid, tau, h.transform, free_space);
+  };
+  auto by_score = [](const Hypothesis& a, const Hypothesis& b) { return a.cloud_score > b.cloud_score; };
+  for (Hypothesis& h : hypotheses) settle(h);
+  std::stable_sort(hypotheses.begin(), hypotheses.end(), by_score);
+  // 4PCS on a symmetric room often finds only the flipped pose; its symmetric twin must compete too.
+  if (!hypotheses.empty()) {
+    const Hypothesis best = hypotheses.front();
+    for (const Eigen::Matrix4d& s : principal_half_turns(target.stages.front().points)) {
+      Hypothesis twin{s * best.transform, 0.0, 0.0};
+      // The estimated centre puts a twin up to about a metre off: a wider first pass pulls it in.
+      IcpParams wide = quick;
+      wide.stages = 1;
+      wide.max_distance_factor = 4.0;
+      wide.max_iterations = 10;
+      twin.transform = refine_icp(source, target, twin.transform, wide, cancel).transform;
+      settle(twin);
+      hypotheses.push_back(twin);
+    }
+    std::stable_sort(hypotheses.begin(), hypotheses.end(), by_score);
   }
-  std::stable_sort(hypotheses.begin(), hypotheses.end(),
-                   [](const Hypothesis& a, const Hypothesis& b) { return a.cloud_score > b.cloud_score; });
   SymmetryGuardResult result;
   // Hypotheses that ICP brought to the same pose are one hypothesis.
   for (const Hypothesis& h : hypotheses)

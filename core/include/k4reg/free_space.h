@@ -17,8 +17,14 @@ class FreeSpaceImage {
   // first return a point must lie to count as contradicted (noise and voxelisation).
   FreeSpaceImage(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& scanner_m, double margin_m);
 
-  // True when q lies in space the scanner saw to be empty.
-  bool contradicts(const Eigen::Vector3f& q) const;
+  enum class Seen {
+    kUnknown,   // no return in that direction (sky, windows, beyond range) or too near the scanner
+    kEmpty,     // q lies in space the scanner saw to be empty: a contradiction
+    kSurface,   // q lies at the first return, within the margin
+    kOccluded,  // q lies behind the first return
+  };
+  Seen classify(const Eigen::Vector3f& q) const;
+  bool contradicts(const Eigen::Vector3f& q) const { return classify(q) == Seen::kEmpty; }
 
   // Median distance of the points from the scanner: small values mean the origin is not a scanner
   // position (e.g. object scans whose frame origin is inside the object).

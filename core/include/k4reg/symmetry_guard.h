@@ -1,8 +1,10 @@
 // The symmetry guard (beyond the paper, whose failures were all 180-degree flips of a symmetric room):
 // each distinct 4PCS hypothesis is settled by a short coarse ICP and re-scored on the voxelised clouds,
 // where the furniture that breaks a room's symmetry is visible: how much of the source the target
-// covers, less how much of it lands in space the target scanner saw to be empty.
-// Cost: a few ICP iterations and one pass over the coarse source per hypothesis.
+// covers, less how much of it lands in space the target scanner saw to be empty (points the target
+// scanner could not see are no evidence). 4PCS on a symmetric room often finds only the flipped pose,
+// so the best hypothesis's twins under half turns about the target's principal axes compete too.
+// Cost: a few ICP iterations and one pass over the coarse source per hypothesis, plus three twins.
 #pragma once
 
 #include <vector>
