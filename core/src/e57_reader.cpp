@@ -33,7 +33,8 @@ struct ScanLayout {
   std::string label;  // "scan 2 ('Station 3')" for messages
   std::string name;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  std::uint64_t section_logical = 0, record_count = 0;
+  std::uint64_t section_logical = 0, section_end = 0, data_logical = 0;  // the binary section, logical offsets
+  std::uint64_t record_count = 0;
   std::vector<FieldCodec> fields;  // one per bytestream, in bytestream order (depth-first over the prototype)
   bool spherical = false;
   int coordinate[3] = {-1, -1, -1};  // x/y/z, or range/azimuth/elevation
@@ -65,7 +66,7 @@ bool parse_int64(std::string_view token, std::int64_t& value) {
 
 class XmlScanParser {
  public:
-  XmlScanParser(const std::string& file_name, const e57::PagedReader& pages) : file_(file_name), pages_(pages) {}
+  XmlScanParser(const std::string& file_name, e57::PagedReader& pages) : file_(file_name), pages_(pages) {}
 
   ScanLayout parse(pugi::xml_node node, std::size_t index) {
     ScanLayout scan;
@@ -81,6 +82,7 @@ class XmlScanParser {
         !e57::physical_to_logical(file_offset, scan.section_logical) ||
         scan.section_logical >= pages_.logical_size())
       fail("points fileOffset '" + std::string(points.attribute("fileOffset").value()) + "' is not inside the file");
+    section_header(scan);
     if (!io_detail::parse_uint64(trimmed(points.attribute("recordCount").value()), scan.record_count))
       fail("points recordCount '" + std::string(points.attribute("recordCount").value()) + "' is not a count");
     const pugi::xml_node prototype = points.child("prototype");
@@ -235,8 +237,22 @@ class XmlScanParser {
     scan.normalise_intensity = scan.intensity_max > scan.intensity_min;
   }
 
+  // The CompressedVector section header at the scan's fileOffset: where the section ends and its data starts.
+  void section_header(ScanLayout& scan) {
+    const std::string header = pages_.read(scan.section_logical, e57::kSectionHeaderSize);
+    if (static_cast<unsigned char>(header[0]) != e57::kCompressedVectorSection)
+      fail("no CompressedVector section at its fileOffset");
+    const std::uint64_t length = load_le<std::uint64_t>(header.data() + 8);
+    if (length < e57::kSectionHeaderSize || length > pages_.logical_size() - scan.section_logical)
+      fail("section length " + std::to_string(length) + " passes the end of the file");
+    scan.section_end = scan.section_logical + length;
+    if (!e57::physical_to_logical(load_le<std::uint64_t>(header.data() + 16), scan.data_logical) ||
+        scan.data_logical < scan.section_logical + e57::kSectionHeaderSize || scan.data_logical >= scan.section_end)
+      fail("the first data packet is not inside the section");
+  }
+
   const std::string& file_;
-  const e57::PagedReader& pages_;
+  e57::PagedReader& pages_;
   std::string label_;
 };
 
@@ -259,17 +275,8 @@ class ScanDecoder {
   }
 
   void decode(const ReadOptions& options, std::vector<Eigen::Vector3d>& points, std::vector<float>& intensity) {
-    const std::string header = pages_.read(scan_.section_logical, e57::kSectionHeaderSize);
-    if (static_cast<unsigned char>(header[0]) != e57::kCompressedVectorSection)
-      fail("no CompressedVector section at its fileOffset");
-    const std::uint64_t length = load_le<std::uint64_t>(header.data() + 8);
-    if (length < e57::kSectionHeaderSize || length > pages_.logical_size() - scan_.section_logical)
-      fail("section length " + std::to_string(length) + " passes the end of the file");
-    end_ = scan_.section_logical + length;
-    std::uint64_t data_logical = 0;
-    if (!e57::physical_to_logical(load_le<std::uint64_t>(header.data() + 16), data_logical) ||
-        data_logical < scan_.section_logical + e57::kSectionHeaderSize || data_logical >= end_)
-      fail("the first data packet is not inside the section");
+    end_ = scan_.section_end;
+    const std::uint64_t length = scan_.section_end - scan_.section_logical;
     std::uint64_t bits_per_record = 0;
     for (const Stream& s : streams_) bits_per_record += scan_.fields[s.field].bits();
     if (!io_detail::mul_fits(scan_.record_count, bits_per_record, 8 * length))
@@ -277,7 +284,7 @@ class ScanDecoder {
            std::to_string(length) + " bytes of its section");
     // Real scans need several bytes per record; a claim of more records than bytes is trusted only as it decodes.
     points.reserve(points.size() + std::min<std::uint64_t>(scan_.record_count, length));
-    for (std::uint64_t pos = data_logical; emitted_ < scan_.record_count;) {
+    for (std::uint64_t pos = scan_.data_logical; emitted_ < scan_.record_count;) {
       if (pos + 4 > end_)
         fail("truncated: the section ends after " + std::to_string(emitted_) + " of " +
              std::to_string(scan_.record_count) + " records");
@@ -464,6 +471,15 @@ PointCloud read_e57_bytes(std::string_view data, const std::string& name, const 
     every_record_is_a_point &= scans.back().invalid_state < 0;
   }
   if (every_record_is_a_point) io_detail::check_point_budget(records, options, name);
+  // Each scan's records must come from its own bytes: scans sharing a section would multiply a small file.
+  std::vector<const ScanLayout*> by_offset;
+  for (const ScanLayout& scan : scans) by_offset.push_back(&scan);
+  std::sort(by_offset.begin(), by_offset.end(),
+            [](const ScanLayout* a, const ScanLayout* b) { return a->section_logical < b->section_logical; });
+  for (std::size_t i = 1; i < by_offset.size(); ++i)
+    if (by_offset[i]->section_logical < by_offset[i - 1]->section_end)
+      fail_io(ErrorCode::kInvalidArgument, name,
+              by_offset[i]->label + "'s binary section overlaps the one of " + by_offset[i - 1]->label);
 
   std::vector<Eigen::Vector3d> points;
   std::vector<float> intensity;

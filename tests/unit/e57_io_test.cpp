@@ -440,6 +440,8 @@ TEST_F(E57IoTest, BadXmlAndBadStructureAreClearErrors) {
       {"posetext.e57", xml_file(scan_xml("t", 0, 2, xyz, "<pose type=\"Structure\"><translation type=\"Structure\"><x type=\"Float\">east</x><y type=\"Float\">0</y><z type=\"Float\">0</z></translation></pose>")), "pose translation x 'east' is not a number"},
       {"streams.e57", xml_file(scan_xml("b", 0, 2, xyz + "<intensity type=\"Float\"/>")), "data packet with 3 bytestreams for a prototype of 4 fields"},
       {"short.e57", xml_file(scan_xml("r", 0, 3, xyz)), "truncated"},
+      {"shared.e57", xml_file(scan_xml("a", 0, 2, xyz) + scan_xml("b", 0, 2, xyz)),
+       "scan 1 ('b')'s binary section overlaps the one of scan 0 ('a')"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.name);
