@@ -24,8 +24,7 @@ using io_detail::load_le;
 
 // Public header block offsets (LAS 1.4 table 3).
 constexpr std::size_t kHeaderSizeAt = 94, kPointOffsetAt = 96, kVlrCountAt = 100, kPointFormatAt = 104,
-                      kRecordLengthAt = 105, kLegacyCountAt = 107, kScaleAt = 131, kOffsetAt = 155, kBoundsAt = 179,
-                      kCount64At = 247;
+                      kRecordLengthAt = 105, kLegacyCountAt = 107, kScaleAt = 131, kOffsetAt = 155, kCount64At = 247;
 constexpr std::size_t kHeaderSize12 = 227, kHeaderSize13 = 235, kHeaderSize14 = 375;
 constexpr std::size_t kVlrHeaderSize = 54;
 constexpr std::size_t kExtraBytesDescriptorSize = 192;
