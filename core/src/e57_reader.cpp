@@ -256,7 +256,7 @@ class XmlScanParser {
   std::string label_;
 };
 
-// Appends the valid points of one scan, in the file's frame; returns false when the scan has no intensity.
+// Appends the valid points of one scan (and their intensity, if the scan has it) in the file's frame.
 class ScanDecoder {
  public:
   ScanDecoder(const ScanLayout& scan, e57::PagedReader& pages, const std::string& name)
@@ -358,9 +358,10 @@ class ScanDecoder {
       if (scan_.invalid_state >= 0 && value(kInvalid, scan_.invalid_state, k) != 0.0) continue;
       const double a = value(0, scan_.coordinate[0], k), b = value(1, scan_.coordinate[1], k),
                    c = value(2, scan_.coordinate[2], k);
-      const Eigen::Vector3d p = scan_.spherical
-                                    ? Eigen::Vector3d(a * std::cos(c) * std::cos(b), a * std::cos(c) * std::sin(b), a * std::sin(c))
-                                    : Eigen::Vector3d(a, b, c);
+      // Spherical: range a, azimuth b, elevation c (radians).
+      const Eigen::Vector3d p = scan_.spherical ? Eigen::Vector3d(a * std::cos(c) * std::cos(b),
+                                                                  a * std::cos(c) * std::sin(b), a * std::sin(c))
+                                                : Eigen::Vector3d(a, b, c);
       if (options.max_points != 0 && points.size() >= options.max_points)
         fail_io(ErrorCode::kResourceExhausted, name_, "more than " + std::to_string(options.max_points) + " points");
       points.push_back(scan_.pose * p);
@@ -371,10 +372,10 @@ class ScanDecoder {
       }
     }
     emitted_ += ready;
-    for (Stream& s : streams_) {
+    for (Stream& s : streams_) {  // drop what was emitted; streams a packet ahead keep their surplus
       s.head += ready;
-      if (s.head == s.values.size()) {
-        s.values.clear();
+      if (s.head == s.values.size() || s.head > (std::size_t{1} << 16)) {
+        s.values.erase(s.values.begin(), s.values.begin() + static_cast<std::ptrdiff_t>(s.head));
         s.head = 0;
       }
     }

@@ -385,6 +385,32 @@ TEST_F(E57IoTest, ScaledIntegersOfEveryWidthAcrossPacketsWithIndexAndEmptyPacket
   }
 }
 
+TEST_F(E57IoTest, StreamsFarOutOfStepAcrossManyPackets) {
+  // All of cartesianX first, then all of Y, then all of Z (a writer may send streams in any proportion): the
+  // reader holds 70 000 decoded X values until Y and Z arrive.
+  const std::size_t n = 70000;
+  std::vector<std::uint64_t> raw[3];
+  for (std::size_t i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a) raw[a].push_back(std::bit_cast<std::uint32_t>(static_cast<float>(i % 1000) * 0.01f + a));
+  std::string packets;
+  for (int a = 0; a < 3; ++a) {
+    const std::string stream = pack(raw[a], 32);
+    for (std::size_t at = 0; at < stream.size(); at += 60001) {  // not a multiple of 4: values straddle packets
+      std::vector<std::string> buffers(3);
+      buffers[a] = stream.substr(at, 60001);
+      packets += data_packet(buffers);
+    }
+  }
+  const std::string prototype = "<cartesianX type=\"Float\" precision=\"single\"/><cartesianY type=\"Float\" "
+                                "precision=\"single\"/><cartesianZ type=\"Float\" precision=\"single\"/>";
+  const PointCloud r = read_e57(write_file("steps.e57", assemble({packets}, xml_file(scan_xml("s", 0, n, prototype)))));
+  ASSERT_EQ(r.size(), n);
+  for (std::size_t i = 0; i < n; i += 997) {
+    const double v = static_cast<float>(i % 1000) * 0.01f;
+    ASSERT_LT((world(r, i) - Eigen::Vector3d(v, v + 1, v + 2)).norm(), 1e-5) << i;
+  }
+}
+
 TEST_F(E57IoTest, NestedPrototypeFieldsKeepTheirBytestreamOrder) {
   // Bytestreams follow the prototype depth-first: colour (3 Integer streams inside a Structure) comes first.
   const std::vector<double> x = {1, 2, 3}, y = {4, 5, 6}, z = {7, 8, 9.5};
