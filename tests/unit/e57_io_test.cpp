@@ -229,9 +229,11 @@ TEST_F(E57IoTest, RoundTripEveryCoordinateEncoding) {
     const auto [lo, hi] = std::minmax_element(c.cloud->intensity.begin(), c.cloud->intensity.end());
     for (std::size_t i = 0; i < r.size(); ++i) ASSERT_NEAR(r.intensity[i], (c.cloud->intensity[i] - *lo) / (*hi - *lo), 1e-6) << i;
   }
-  // write_cloud's .e57: one scan of doubles.
+  // write_cloud's .e57: one scan of doubles; detected by its magic under any name.
   write_cloud(path("wc.e57"), utm);
   EXPECT_EQ(read_cloud(path("wc.e57")).size(), utm.size());
+  fs::rename(path("wc.e57"), path("wc.ply"));
+  EXPECT_EQ(detect_format(path("wc.ply")), CloudFormat::kE57);
 }
 
 TEST_F(E57IoTest, IntegerIntensityOfAnyWidthIsNormalisedByItsLimits) {

@@ -156,6 +156,7 @@ TEST_F(LasIoTest, HandBuiltLegacyFileWithVlrsAndExtraBytes) {
   const std::string bytes = h.bytes() + record(1234567, -5678, 9, 65535, 33) + record(0, 0, 0, 0, 33) +
                             record(-2147483647 - 1, 2147483647, -1, 32768, 33);
   const PointCloud c = read_cloud(write_file("hand.las", bytes));
+  EXPECT_EQ(detect_format(write_file("hand.xyz", bytes)), CloudFormat::kLas);  // the magic wins over the extension
   ASSERT_EQ(c.size(), 3u);
   EXPECT_LT((world(c, 0) - Eigen::Vector3d(500001.234567, 5239999.994322, 300.000009)).norm(), 1e-4);
   EXPECT_LT((world(c, 1) - Eigen::Vector3d(500000, 5240000, 300)).norm(), 1e-4);

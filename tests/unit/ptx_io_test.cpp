@@ -48,6 +48,8 @@ TEST_F(PtxIoTest, HandWrittenScanHonoursTheMatrixAndSkipsZeroPoints) {
                            "0 0 0 0.5 0 0 0\n";
   const std::string p = write_file("hand.ptx", text);
   EXPECT_EQ(detect_format(p), CloudFormat::kPtx);
+  EXPECT_EQ(detect_format(write_file("hand.txt", text)), CloudFormat::kPtx);  // content over a text extension
+  EXPECT_EQ(read_cloud(path("hand.txt")).size(), 3u);
   const PointCloud c = read_cloud(p);
   ASSERT_EQ(c.size(), 3u);
   EXPECT_LT((world(c, 0) - Eigen::Vector3d(500000, 5240001, 300)).norm(), 1e-6);
