@@ -7,8 +7,13 @@
 namespace k4reg {
 namespace {
 
-// Half-degree cells: about 9 cm at 10 m, coarse enough that voxelised scans fill them.
-constexpr int kAzimuthCells = 720, kElevationCells = 360;
+// Cells of about four returns each on average (half a degree for 0.7 M points over the sphere, about
+// 9 cm at 10 m): fine enough to see past furniture, coarse enough that the scan fills them.
+int elevation_cells_for(std::size_t points) {
+  constexpr double kReturnsPerCell = 4.0;
+  const double cell_rad = std::sqrt(4.0 * M_PI * kReturnsPerCell / std::max<std::size_t>(points, 1));
+  return std::clamp(static_cast<int>(M_PI / cell_rad), 45, 1800);  // 4 to 0.1 degrees
+}
 
 }  // namespace
 
@@ -16,7 +21,9 @@ FreeSpaceImage::FreeSpaceImage(const std::vector<Eigen::Vector3f>& points, const
                                double margin_m)
     : scanner_(scanner_m),
       margin_(static_cast<float>(margin_m)),
-      nearest_(kAzimuthCells * kElevationCells, std::numeric_limits<float>::infinity()) {
+      elevation_cells_(elevation_cells_for(points.size())),
+      azimuth_cells_(2 * elevation_cells_),
+      nearest_(static_cast<std::size_t>(azimuth_cells_) * elevation_cells_, std::numeric_limits<float>::infinity()) {
   for (const Eigen::Vector3f& p : points) {
     const Eigen::Vector3f d = p - scanner_;
     const float range = d.norm();
@@ -29,9 +36,9 @@ FreeSpaceImage::FreeSpaceImage(const std::vector<Eigen::Vector3f>& points, const
 int FreeSpaceImage::cell(const Eigen::Vector3f& u) const {
   const float azimuth = std::atan2(u.y(), u.x()) + static_cast<float>(M_PI);      // [0, 2 pi]
   const float elevation = std::acos(std::clamp(u.z(), -1.0f, 1.0f));               // [0, pi]
-  const int a = std::min(kAzimuthCells - 1, static_cast<int>(azimuth * (kAzimuthCells / (2 * M_PI))));
-  const int e = std::min(kElevationCells - 1, static_cast<int>(elevation * (kElevationCells / M_PI)));
-  return e * kAzimuthCells + a;
+  const int a = std::min(azimuth_cells_ - 1, static_cast<int>(azimuth * (azimuth_cells_ / (2 * M_PI))));
+  const int e = std::min(elevation_cells_ - 1, static_cast<int>(elevation * (elevation_cells_ / M_PI)));
+  return e * azimuth_cells_ + a;
 }
 
 FreeSpaceImage::Seen FreeSpaceImage::classify(const Eigen::Vector3f& q) const {

@@ -15,28 +15,33 @@ namespace k4reg {
 namespace {
 
 // Without free space: the share of source points with a target point within tau. With the target's
-// free space, points the target scanner could not have seen (behind its first return, or where it got
-// no return) and did not match are no evidence either way; counting them as misses favours the pose
-// that maps one scanner's occlusion shadows onto the other's — in a symmetric room, the flip. So the
-// score is, of the points with evidence, the share matched less the share the target saw through.
+// free space, a point is also consistent where it lies at the target scanner's first return in its
+// direction (sparse far surfaces have gaps wider than tau), contradicted where the target scanner saw
+// through it, and no evidence either way where that scanner could not see it (behind its first return,
+// or no return). Counting unseen points as misses favours the pose that maps one scanner's occlusion
+// shadows onto the other's — in a symmetric room, the flip. So the score is, of the points with
+// evidence, the share consistent less the share contradicted.
 double cloud_score(const std::vector<Eigen::Vector3f>& source, const NeighborGrid& grid, float tau,
                    const Eigen::Matrix4d& t, const FreeSpaceImage* free_space) {
   const Eigen::Affine3f a = to_affine3f(t);
-  std::size_t hits = 0, contradicted = 0, unseen = 0;
+  std::size_t consistent = 0, contradicted = 0, unseen = 0;
   for (const Eigen::Vector3f& p : source) {
     const Eigen::Vector3f q = a * p;
     if (grid.any_within(q, tau)) {
-      ++hits;
+      ++consistent;
       continue;
     }
     if (!free_space) continue;
-    const FreeSpaceImage::Seen seen = free_space->classify(q);
-    if (seen == FreeSpaceImage::Seen::kEmpty) ++contradicted;
-    if (seen == FreeSpaceImage::Seen::kOccluded || seen == FreeSpaceImage::Seen::kUnknown) ++unseen;
+    switch (free_space->classify(q)) {
+      case FreeSpaceImage::Seen::kSurface: ++consistent; break;
+      case FreeSpaceImage::Seen::kEmpty: ++contradicted; break;
+      case FreeSpaceImage::Seen::kOccluded:
+      case FreeSpaceImage::Seen::kUnknown: ++unseen; break;
+    }
   }
   // A floor of 5 % of the points keeps poses that put nearly everything out of sight from scoring high.
   const double evidence = std::max(static_cast<double>(source.size() - unseen), 0.05 * source.size());
-  return (static_cast<double>(hits) - static_cast<double>(contradicted)) / std::max(1.0, evidence);
+  return (static_cast<double>(consistent) - static_cast<double>(contradicted)) / std::max(1.0, evidence);
 }
 
 // Centre of the middle 90 % of the points per axis: a room scan's stray points through windows and
@@ -99,14 +104,17 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   // 4PCS on a symmetric room often finds only the flipped pose; its symmetric twin must compete too.
   if (!hypotheses.empty()) {
     const Hypothesis best = hypotheses.front();
+    // The estimated centre can put a twin a metre or two off, beyond the guard's ICP stages: two coarser
+    // stages (4 and 8 times the coarsest spacing, a few thousand points) pull it in first.
+    IcpParams wide;
+    wide.voxel_m = 2.0 * source.stages.front().voxel_m;
+    wide.stages = 2;
+    wide.max_iterations = 10;
+    const IcpPyramid wide_source = make_icp_pyramid(source.stages.front().points, wide, false, cancel);
+    const IcpPyramid wide_target = make_icp_pyramid(target.stages.front().points, wide, true, cancel);
     for (const Eigen::Matrix4d& s : principal_half_turns(target.stages.front().points)) {
       Hypothesis twin{s * best.transform, 0.0, 0.0};
-      // The estimated centre puts a twin up to about a metre off: a wider first pass pulls it in.
-      IcpParams wide = quick;
-      wide.stages = 1;
-      wide.max_distance_factor = 4.0;
-      wide.max_iterations = 10;
-      twin.transform = refine_icp(source, target, twin.transform, wide, cancel).transform;
+      twin.transform = refine_icp(wide_source, wide_target, twin.transform, wide, cancel).transform;
       settle(twin);
       hypotheses.push_back(twin);
     }

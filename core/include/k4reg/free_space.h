@@ -3,7 +3,7 @@
 // by 180 degrees fits walls, floor and ceiling as well as the truth does — often better — but puts
 // the furniture of one scan where the other scanner looked through empty space. Counting these
 // violations is what separates the two (paper's named weakness: symmetric rooms).
-// Cost: O(n) to build a spherical range image; O(1) per query.
+// Cost: O(n) to build a spherical range image (cells sized to the scan's density); O(1) per query.
 #pragma once
 
 #include <Eigen/Core>
@@ -34,6 +34,7 @@ class FreeSpaceImage {
   int cell(const Eigen::Vector3f& direction) const;
   Eigen::Vector3f scanner_;
   float margin_;
+  int elevation_cells_, azimuth_cells_;  // from the point count: a few returns per cell
   std::vector<float> nearest_;  // nearest return per (azimuth, elevation) cell; +inf where none
 };
 
