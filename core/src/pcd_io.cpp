@@ -167,7 +167,8 @@ PcdHeader parse_header(std::string_view data, const std::string& name) {
   std::vector<std::string_view> sizes, types, counts;
   bool have_fields = false, have_data = false, first = true;
   while (lines.next(line)) {
-    const std::string where = "header line " + std::to_string(lines.line_number()) + ": ";
+    // Built only for an error: headers may have many lines.
+    auto where = [&lines] { return "header line " + std::to_string(lines.line_number()) + ": "; };
     std::size_t p = line.find_first_not_of(" \t\r");
     if (p == std::string_view::npos) continue;
     line.remove_prefix(p);
@@ -176,13 +177,13 @@ PcdHeader parse_header(std::string_view data, const std::string& name) {
     if (tok.empty()) continue;  // separators only (",", "\v", ...)
     if (tok.size() > io_detail::kMaxTokensPerLine)
       fail_io(ErrorCode::kInvalidArgument, name,
-              where + "more than " + std::to_string(io_detail::kMaxTokensPerLine) + " fields or values on one line");
+              where() + "more than " + std::to_string(io_detail::kMaxTokensPerLine) + " fields or values on one line");
     const std::string_view key = tok[0];
     auto values = [&]() { return std::vector<std::string_view>(tok.begin() + 1, tok.end()); };
     auto one_uint = [&](std::uint64_t& v) {
       if (tok.size() != 2 || !io_detail::parse_uint64(tok[1], v))
         fail_io(ErrorCode::kInvalidArgument, name,
-                where + std::string(key) + " needs one non-negative integer, found " + io_detail::quote(line));
+                where() + std::string(key) + " needs one non-negative integer, found " + io_detail::quote(line));
     };
     if (key == "VERSION") {
       // Any version string accepted (0.5 … 0.7 share the layout we read).
@@ -211,7 +212,7 @@ PcdHeader parse_header(std::string_view data, const std::string& name) {
     } else if (key == "VIEWPOINT") {
       // Sensor pose; points are returned in the file's frame, so it is not applied.
     } else if (key == "DATA") {
-      if (tok.size() != 2) fail_io(ErrorCode::kInvalidArgument, name, where + "malformed DATA line");
+      if (tok.size() != 2) fail_io(ErrorCode::kInvalidArgument, name, where() + "malformed DATA line");
       if (tok[1] == "ascii") {
         header.data = PcdData::kAscii;
       } else if (tok[1] == "binary") {
@@ -219,7 +220,7 @@ PcdHeader parse_header(std::string_view data, const std::string& name) {
       } else if (tok[1] == "binary_compressed") {
         header.data = PcdData::kBinaryCompressed;
       } else {
-        fail_io(ErrorCode::kInvalidArgument, name, where + "unknown DATA encoding " + io_detail::quote(tok[1]));
+        fail_io(ErrorCode::kInvalidArgument, name, where() + "unknown DATA encoding " + io_detail::quote(tok[1]));
       }
       have_data = true;
       break;
@@ -227,7 +228,7 @@ PcdHeader parse_header(std::string_view data, const std::string& name) {
       fail_io(ErrorCode::kInvalidArgument, name,
               "not a PCD file: wrong header (first line " + io_detail::quote(line) + ")");
     } else {
-      fail_io(ErrorCode::kInvalidArgument, name, where + "unknown header keyword " + io_detail::quote(key));
+      fail_io(ErrorCode::kInvalidArgument, name, where() + "unknown header keyword " + io_detail::quote(key));
     }
     first = false;
   }

@@ -115,7 +115,7 @@ PlyHeader parse_header(std::string_view data, const std::string& name) {
   bool have_format = false, have_end = false;
   while (lines.next(line)) {
     const std::size_t ln = lines.line_number();
-    const std::string where = "header line " + std::to_string(ln) + ": ";
+    auto where = [ln] { return "header line " + std::to_string(ln) + ": "; };  // built only for an error
     std::vector<std::string_view> tok = split_ws(line);
     if (tok.empty()) continue;
     const std::string_view key = tok[0];
@@ -125,7 +125,7 @@ PlyHeader parse_header(std::string_view data, const std::string& name) {
     }
     if (key == "comment" || key == "obj_info") continue;
     if (key == "format") {
-      if (tok.size() != 3) fail_io(ErrorCode::kInvalidArgument, name, where + "malformed format line");
+      if (tok.size() != 3) fail_io(ErrorCode::kInvalidArgument, name, where() + "malformed format line");
       if (tok[1] == "ascii") {
         header.format = PlyFormat::kAscii;
       } else if (tok[1] == "binary_little_endian") {
@@ -133,46 +133,46 @@ PlyHeader parse_header(std::string_view data, const std::string& name) {
       } else if (tok[1] == "binary_big_endian") {
         header.format = PlyFormat::kBinaryBigEndian;
       } else {
-        fail_io(ErrorCode::kInvalidArgument, name, where + "unknown PLY format " + io_detail::quote(tok[1]));
+        fail_io(ErrorCode::kInvalidArgument, name, where() + "unknown PLY format " + io_detail::quote(tok[1]));
       }
       if (tok[2] != "1.0" && tok[2] != "1")
-        fail_io(ErrorCode::kInvalidArgument, name, where + "unsupported PLY version " + io_detail::quote(tok[2]));
+        fail_io(ErrorCode::kInvalidArgument, name, where() + "unsupported PLY version " + io_detail::quote(tok[2]));
       have_format = true;
     } else if (key == "element") {
-      if (tok.size() != 3) fail_io(ErrorCode::kInvalidArgument, name, where + "malformed element line");
+      if (tok.size() != 3) fail_io(ErrorCode::kInvalidArgument, name, where() + "malformed element line");
       PlyElement element;
       element.name = std::string(tok[1]);
       if (!io_detail::parse_uint64(tok[2], element.count))
         fail_io(ErrorCode::kInvalidArgument, name,
-                where + "element count " + io_detail::quote(tok[2]) + " is not a non-negative integer");
+                where() + "element count " + io_detail::quote(tok[2]) + " is not a non-negative integer");
       element.header_line = ln;
       if (header.elements.size() == io_detail::kMaxHeaderEntries)
         fail_io(ErrorCode::kInvalidArgument, name,
-                where + "more than " + std::to_string(io_detail::kMaxHeaderEntries) + " elements");
+                where() + "more than " + std::to_string(io_detail::kMaxHeaderEntries) + " elements");
       header.elements.push_back(std::move(element));
     } else if (key == "property") {
       if (header.elements.empty())
-        fail_io(ErrorCode::kInvalidArgument, name, where + "property before any element");
+        fail_io(ErrorCode::kInvalidArgument, name, where() + "property before any element");
       PlyElement& element = header.elements.back();
       if (element.properties.size() == io_detail::kMaxHeaderEntries)
         fail_io(ErrorCode::kInvalidArgument, name,
-                where + "element '" + element.name + "' has more than " +
+                where() + "element '" + element.name + "' has more than " +
                     std::to_string(io_detail::kMaxHeaderEntries) + " properties");
       PlyProperty prop;
       if (tok.size() >= 2 && tok[1] == "list") {
-        if (tok.size() != 5) fail_io(ErrorCode::kInvalidArgument, name, where + "malformed list property");
+        if (tok.size() != 5) fail_io(ErrorCode::kInvalidArgument, name, where() + "malformed list property");
         if (!parse_type(tok[2], prop.count_type) || !parse_type(tok[3], prop.type))
-          fail_io(ErrorCode::kInvalidArgument, name, where + "unknown property type in list");
+          fail_io(ErrorCode::kInvalidArgument, name, where() + "unknown property type in list");
         if (prop.count_type == PlyType::kFloat32 || prop.count_type == PlyType::kFloat64)
-          fail_io(ErrorCode::kInvalidArgument, name, where + "list count type must be an integer type");
+          fail_io(ErrorCode::kInvalidArgument, name, where() + "list count type must be an integer type");
         prop.is_list = true;
         prop.name = std::string(tok[4]);
         element.has_list = true;
         element.min_bytes += type_size(prop.count_type);
       } else {
-        if (tok.size() != 3) fail_io(ErrorCode::kInvalidArgument, name, where + "malformed property line");
+        if (tok.size() != 3) fail_io(ErrorCode::kInvalidArgument, name, where() + "malformed property line");
         if (!parse_type(tok[1], prop.type))
-          fail_io(ErrorCode::kInvalidArgument, name, where + "unknown property type " + io_detail::quote(tok[1]));
+          fail_io(ErrorCode::kInvalidArgument, name, where() + "unknown property type " + io_detail::quote(tok[1]));
         prop.name = std::string(tok[2]);
         prop.offset = element.stride;
         element.stride += type_size(prop.type);
@@ -181,7 +181,7 @@ PlyHeader parse_header(std::string_view data, const std::string& name) {
       element.min_tokens += 1;
       element.properties.push_back(std::move(prop));
     } else {
-      fail_io(ErrorCode::kInvalidArgument, name, where + "unknown header keyword " + io_detail::quote(key));
+      fail_io(ErrorCode::kInvalidArgument, name, where() + "unknown header keyword " + io_detail::quote(key));
     }
   }
   if (!have_end) fail_io(ErrorCode::kInvalidArgument, name, "malformed header: no end_header line");
