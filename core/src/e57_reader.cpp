@@ -71,7 +71,7 @@ class XmlScanParser {
   ScanLayout parse(pugi::xml_node node, std::size_t index) {
     ScanLayout scan;
     scan.name = text_of(node.child("name"));
-    scan.label = "scan " + std::to_string(index) + (scan.name.empty() ? "" : " ('" + scan.name + "')");
+    scan.label = "scan " + std::to_string(index) + (scan.name.empty() ? "" : " (" + io_detail::quote(scan.name) + ")");
     label_ = scan.label;
     if (const pugi::xml_node pose = node.child("pose")) parse_pose(pose, scan.pose);
     const pugi::xml_node points = node.child("points");
@@ -81,10 +81,10 @@ class XmlScanParser {
     if (!io_detail::parse_uint64(trimmed(points.attribute("fileOffset").value()), file_offset) ||
         !e57::physical_to_logical(file_offset, scan.section_logical) ||
         scan.section_logical >= pages_.logical_size())
-      fail("points fileOffset '" + std::string(points.attribute("fileOffset").value()) + "' is not inside the file");
+      fail("points fileOffset " + io_detail::quote(points.attribute("fileOffset").value()) + " is not inside the file");
     section_header(scan);
     if (!io_detail::parse_uint64(trimmed(points.attribute("recordCount").value()), scan.record_count))
-      fail("points recordCount '" + std::string(points.attribute("recordCount").value()) + "' is not a count");
+      fail("points recordCount " + io_detail::quote(points.attribute("recordCount").value()) + " is not a count");
     const pugi::xml_node prototype = points.child("prototype");
     if (!prototype) fail("points have no prototype");
     std::vector<std::string> names;
@@ -108,14 +108,14 @@ class XmlScanParser {
     const std::string text = text_of(node);
     double value = 0.0;
     if (type == "Float") {
-      if (!text.empty() && !io_detail::parse_double(text, value)) fail(what + " '" + std::string(text) + "' is not a number");
+      if (!text.empty() && !io_detail::parse_double(text, value)) fail(what + " " + io_detail::quote(text) + " is not a number");
     } else if (type == "Integer" || type == "ScaledInteger") {
       std::int64_t integer = 0;
-      if (!text.empty() && !parse_int64(text, integer)) fail(what + " '" + std::string(text) + "' is not an integer");
+      if (!text.empty() && !parse_int64(text, integer)) fail(what + " " + io_detail::quote(text) + " is not an integer");
       value = static_cast<double>(integer);
       if (type == "ScaledInteger") value = value * attribute(node, "scale", 1.0) + attribute(node, "offset", 0.0);
     } else {
-      fail(what + " has type '" + std::string(type) + "', not a number type");
+      fail(what + " has type " + io_detail::quote(type) + ", not a number type");
     }
     if (!std::isfinite(value)) fail(what + " is not finite");
     return value;
@@ -126,7 +126,7 @@ class XmlScanParser {
     if (!a) return fallback;
     double value;
     if (!io_detail::parse_double(trimmed(a.value()), value) || !std::isfinite(value))
-      fail(std::string(node.name()) + " " + key + " '" + a.value() + "' is not a finite number");
+      fail(io_detail::quote(node.name()) + " " + key + " " + io_detail::quote(a.value()) + " is not a finite number");
     return value;
   }
 
@@ -135,7 +135,7 @@ class XmlScanParser {
     if (!a) return fallback;
     std::int64_t value;
     if (!parse_int64(trimmed(a.value()), value))
-      fail(std::string(node.name()) + " " + key + " '" + a.value() + "' is not a 64-bit integer");
+      fail(io_detail::quote(node.name()) + " " + key + " " + io_detail::quote(a.value()) + " is not a 64-bit integer");
     return value;
   }
 
@@ -160,7 +160,7 @@ class XmlScanParser {
     if (type == "Float") {
       const std::string_view precision = node.attribute("precision").value();
       if (precision != "" && precision != "single" && precision != "double")
-        fail(std::string(node.name()) + " precision '" + std::string(precision) + "' is neither single nor double");
+        fail(io_detail::quote(node.name()) + " precision " + io_detail::quote(precision) + " is neither single nor double");
       c.single_precision = precision == "single";
       return c;
     }
@@ -169,15 +169,15 @@ class XmlScanParser {
       return c;
     }
     if (type != "Integer" && type != "ScaledInteger")
-      fail("prototype field " + std::string(node.name()) + " has unsupported type '" + std::string(type) + "'");
+      fail("prototype field " + io_detail::quote(node.name()) + " has unsupported type " + io_detail::quote(type));
     c.type = type == "Integer" ? FieldCodec::Type::kInteger : FieldCodec::Type::kScaledInteger;
     c.minimum = attribute(node, "minimum", std::numeric_limits<std::int64_t>::min());
     c.maximum = attribute(node, "maximum", std::numeric_limits<std::int64_t>::max());
-    if (c.minimum > c.maximum) fail(std::string(node.name()) + " minimum is above its maximum");
+    if (c.minimum > c.maximum) fail(io_detail::quote(node.name()) + " minimum is above its maximum");
     if (c.type == FieldCodec::Type::kScaledInteger) {
       c.scale = attribute(node, "scale", 1.0);
       c.offset = attribute(node, "offset", 0.0);
-      if (c.scale == 0.0) fail(std::string(node.name()) + " scale is 0");
+      if (c.scale == 0.0) fail(io_detail::quote(node.name()) + " scale is 0");
     }
     return c;
   }
@@ -450,14 +450,14 @@ PointCloud read_e57_bytes(std::string_view data, const std::string& name, const 
     for (std::size_t i = 0; i < entries.size(); ++i) {
       const std::string scan_name = text_of(entries[i].child("name"));
       if (scan_name == options.scan_name) selected.push_back(i);
-      if (i < 20) names += std::string(i ? ", '" : "'") + scan_name + "'";
+      if (i < 20) names += (i ? ", " : "") + io_detail::quote(scan_name);
     }
     if (selected.empty())
       fail_io(ErrorCode::kInvalidArgument, name,
-              "no scan named '" + options.scan_name + "' (scans: " + names + (entries.size() > 20 ? ", …)" : ")"));
+              "no scan named " + io_detail::quote(options.scan_name) + " (scans: " + names + (entries.size() > 20 ? ", …)" : ")"));
     if (selected.size() > 1)
       fail_io(ErrorCode::kInvalidArgument, name,
-              std::to_string(selected.size()) + " scans are named '" + options.scan_name + "'; select one by index");
+              std::to_string(selected.size()) + " scans are named " + io_detail::quote(options.scan_name) + "; select one by index");
   } else {
     for (std::size_t i = 0; i < entries.size(); ++i) selected.push_back(i);
   }

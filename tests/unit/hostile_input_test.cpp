@@ -1,6 +1,7 @@
-// Hostile files for every reader, through read_cloud_bytes as the service reads uploads and inline clouds:
-// claimed-huge counts, huge headers and fields, truncated bodies, NaN/Inf and absurd coordinates, empty files,
-// binary garbage. Each must be refused with its typed error naming the file, within 50 ms, and without any
+// Hostile files for every reader (PLY, PCD, PTS/XYZ text, LAS, PTX, E57), through read_cloud_bytes as the service
+// reads uploads and inline clouds: claimed-huge counts, huge headers, fields and strings, deep XML nesting,
+// truncated bodies, page CRC mismatches, NaN/Inf and absurd coordinates, empty files, binary garbage. Each must be
+// refused with its typed error naming the file in a message of at most 1 KiB, within 50 ms, and without any
 // single allocation beyond 1 MiB + 8 bytes per input byte: a reader that sizes a buffer from a header's claim
 // fails here even when that allocation would have succeeded.
 #include <gtest/gtest.h>
@@ -10,14 +11,23 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
 #include <limits>
 #include <new>
 #include <random>
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "k4reg/cloud_io.h"
+#include "k4reg/crc32c.h"
+#include "k4reg/e57_io.h"
 #include "k4reg/error.h"
+#include "k4reg/las_io.h"
+#include "k4reg/ptx_io.h"
 #include "k4reg/voxel_grid.h"
 
 // ---- allocation probe ------------------------------------------------------------------------------------
@@ -138,6 +148,7 @@ void expect_refused(const Hostile& h) {
     const std::string message = e.what();
     EXPECT_EQ(message.rfind(h.name + ": ", 0), 0u) << message;
     EXPECT_NE(message.find(h.needle), std::string::npos) << "expected '" << h.needle << "' in: " << message;
+    EXPECT_LE(message.size(), 1024u) << "the message echoes the input: " << message.substr(0, 200) << "...";
   }
   EXPECT_LT(milliseconds_since(start), kMaxRefusalMs);
   EXPECT_LE(probe.largest(), allocation_limit(h.bytes.size()));
@@ -175,6 +186,33 @@ std::string binary_ply(const std::vector<double>& values) {
   std::string bytes = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(values.size() / 3) +
                       "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
   for (double v : values) put(bytes, v);
+  return bytes;
+}
+
+// The bytes a writer produces for a small cloud (for the formats whose hostile variants are patched valid files).
+std::string written(const std::function<void(const std::string&)>& write) {
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("k4reg-hostile-" + std::to_string(::getpid()) + ".bin");
+  write(path.string());
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::filesystem::remove(path);
+  return bytes;
+}
+
+PointCloud small_cloud() {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<float> intensity;
+  for (int i = 0; i < 30; ++i) {
+    points.emplace_back(i % 5 * 0.1, i / 5 * 0.1, (i % 3) * 0.05);
+    intensity.push_back(static_cast<float>(i));
+  }
+  return make_local_cloud(points, intensity);
+}
+
+template <typename T>
+std::string patched(std::string bytes, std::size_t offset, T value) {
+  std::memcpy(bytes.data() + offset, &value, sizeof(T));
   return bytes;
 }
 
@@ -308,6 +346,135 @@ TEST(HostileInput, PtsAndXyzText) {
   AllocationProbe probe;
   EXPECT_EQ(read_cloud_bytes("1000000000000\n1 2 3 4\n", "claim.pts").size(), 1u);
   EXPECT_LE(probe.largest(), allocation_limit(0));
+}
+
+TEST(HostileInput, Las) {
+  const std::string las = written([](const std::string& path) { write_las(path, small_cloud()); });  // 1.4, format 6
+  // Public header offsets (LAS 1.4 table 3).
+  constexpr std::size_t kHeaderSize = 94, kPointOffset = 96, kFormat = 104, kRecordLength = 105, kScale = 131,
+                        kCount64 = 247;
+  LasWriteOptions v12;
+  v12.version_minor = 2;
+  v12.point_format = 1;
+  const std::string legacy = written([&](const std::string& path) { write_las(path, small_cloud(), v12); });
+  expect_all_refused({
+      {"empty file", "scan.las", "", ErrorCode::kInvalidArgument, "empty file"},
+      {"magic and 100 bytes", "scan.las", "LASF" + std::string(96, '\0'), ErrorCode::kInvalidArgument, "truncated"},
+      {"10^12 points in a small file", "scan.las", patched<std::uint64_t>(las, kCount64, 1000000000000), ErrorCode::kInvalidArgument,
+       "truncated"},
+      {"2^64-1 points", "scan.las", patched<std::uint64_t>(las, kCount64, ~std::uint64_t{0}), ErrorCode::kInvalidArgument,
+       "truncated"},
+      {"legacy count 2^32-1", "scan.las", patched<std::uint32_t>(legacy, 107, ~std::uint32_t{0}), ErrorCode::kInvalidArgument,
+       "truncated"},
+      {"header size past the file", "scan.las", patched<std::uint16_t>(las.substr(0, 400), kHeaderSize, 65535),
+       ErrorCode::kInvalidArgument, "truncated"},
+      {"point data offset past the file", "scan.las", patched<std::uint32_t>(las, kPointOffset, 0xFFFFFFF0u),
+       ErrorCode::kInvalidArgument, "outside the file"},
+      {"record length 0", "scan.las", patched<std::uint16_t>(las, kRecordLength, 0), ErrorCode::kInvalidArgument, "below"},
+      {"LAZ compression bits", "scan.las", patched<std::uint8_t>(las, kFormat, 0x86), ErrorCode::kInvalidArgument, "LAZ"},
+      {"NaN scale", "scan.las", patched(las, kScale, std::numeric_limits<double>::quiet_NaN()), ErrorCode::kInvalidArgument,
+       "scale"},
+      {"scale of 1e300", "scan.las", patched(las, kScale, 1e300), ErrorCode::kInvalidArgument, "beyond"},
+      {"truncated records", "scan.las", las.substr(0, las.size() - 3), ErrorCode::kInvalidArgument, "truncated"},
+      {"binary garbage after the magic", "scan.las", "LASF" + garbage(4096, 7), ErrorCode::kInvalidArgument, ""},
+  });
+}
+
+TEST(HostileInput, Ptx) {
+  const std::string header = "1000000000000\n1000000000000\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n";
+  const std::string matrix = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n";
+  expect_all_refused({
+      {"empty file", "scan.ptx", "", ErrorCode::kInvalidArgument, "empty file"},
+      {"10^12 x 10^12 points", "scan.ptx", header + "1 2 3 0.5\n", ErrorCode::kInvalidArgument, "truncated"},
+      {"columns x rows overflows 64 bits", "scan.ptx", "9223372036854775807\n4\n" + matrix + "1 2 3\n",
+       ErrorCode::kInvalidArgument, "truncated"},
+      {"NaN in the matrix", "scan.ptx", "1\n1\n0 0 0\n1 0 0\n0 1 0\n0 0 1\nnan 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n1 2 3\n",
+       ErrorCode::kInvalidArgument, "matrix"},
+      {"NaN point", "scan.ptx", "2\n1\n" + matrix + "1 2 3 0.5\n4 nan 6 0.5\n", ErrorCode::kInvalidArgument, "NaN"},
+      {"1 MiB point line", "scan.ptx", "1\n1\n" + matrix + repeat("1 ", 1 << 19) + "\n", ErrorCode::kInvalidArgument,
+       "numbers"},
+      {"truncated scan", "scan.ptx", "3\n1\n" + matrix + "1 2 3\n4 5 6\n", ErrorCode::kInvalidArgument, "truncated"},
+      {"10 000 empty scans", "scan.ptx", repeat("0\n0\n" + matrix, 10000), ErrorCode::kInvalidArgument, "no points"},
+      {"binary garbage", "scan.ptx", garbage(4096, 8), ErrorCode::kInvalidArgument, ""},
+  });
+}
+
+// An E57 file around `xml`: the 48-byte header (declaring `xml_length`, default the XML's size), then `binary`
+// (sections the XML may point to at logical offset 48), then the XML, in 1024-byte pages with their CRC-32C
+// (big-endian, as the reader expects).
+std::string e57_file(const std::string& xml, const std::string& binary = "", std::uint64_t xml_length = 0) {
+  std::string logical(48, '\0');
+  logical += binary;
+  const std::uint64_t xml_logical = logical.size();
+  logical += xml;
+  const std::uint64_t pages = (logical.size() + 1019) / 1020;
+  std::memcpy(logical.data(), "ASTM-E57", 8);
+  auto put_at = [&](std::size_t offset, auto value) { std::memcpy(logical.data() + offset, &value, sizeof value); };
+  put_at(8, std::uint32_t{1});
+  put_at(16, std::uint64_t{pages * 1024});
+  put_at(24, std::uint64_t{xml_logical / 1020 * 1024 + xml_logical % 1020});
+  put_at(32, xml_length != 0 ? xml_length : std::uint64_t{xml.size()});
+  put_at(40, std::uint64_t{1024});
+  logical.resize(pages * 1020, '\0');
+  std::string file;
+  for (std::uint64_t p = 0; p < pages; ++p) {
+    const std::string_view page(logical.data() + p * 1020, 1020);
+    file += page;
+    const std::uint32_t crc = crc32c(page);
+    for (int k = 0; k < 4; ++k) file += static_cast<char>(crc >> (24 - 8 * k));
+  }
+  return file;
+}
+
+// A scan entry whose points (CompressedVector at physical offset 48) have `prototype` and `records` records.
+std::string e57_scan(const std::string& prototype, const std::string& records) {
+  return "<vectorChild type=\"Structure\"><points type=\"CompressedVector\" fileOffset=\"48\" recordCount=\"" +
+         records + "\"><prototype type=\"Structure\">" + prototype + "</prototype><codecs type=\"Vector\"/></points>"
+         "</vectorChild>";
+}
+
+std::string e57_root(const std::string& scans) {
+  return "<?xml version=\"1.0\"?><e57Root type=\"Structure\"><data3D type=\"Vector\">" + scans + "</data3D></e57Root>";
+}
+
+TEST(HostileInput, E57) {
+  // A CompressedVector section of 96 bytes at logical 48 whose data starts right after its 32-byte header.
+  std::string section(96, '\0');
+  section[0] = 1;
+  const std::uint64_t section_length = 96, data_physical = 48 + 32;
+  std::memcpy(section.data() + 8, &section_length, 8);
+  std::memcpy(section.data() + 16, &data_physical, 8);
+  const std::string xyz = "<cartesianX type=\"Float\"/><cartesianY type=\"Float\"/><cartesianZ type=\"Float\"/>";
+  const std::string nested = repeat("<s type=\"Structure\">", 100000) + xyz + repeat("</s>", 100000);
+  std::string deep_xml = e57_root("");
+  deep_xml.insert(deep_xml.find("</e57Root>"), repeat("<x>", 100000) + repeat("</x>", 100000));
+
+  E57Scan scan{"scan", small_cloud(), Eigen::Isometry3d::Identity(), {}};
+  const std::string valid = written([&](const std::string& path) { write_e57(path, {scan}); });
+  std::string bad_crc = valid;
+  bad_crc[1024 + 100] ^= 0x20;  // a data byte of page 1
+  expect_all_refused({
+      {"empty file", "scan.e57", "", ErrorCode::kInvalidArgument, "empty file"},
+      {"magic and 100 bytes", "scan.e57", "ASTM-E57" + std::string(92, '\0'), ErrorCode::kInvalidArgument, "truncated"},
+      {"declared length 2^60", "scan.e57", patched<std::uint64_t>(valid, 16, std::uint64_t{1} << 60),
+       ErrorCode::kInvalidArgument, "truncated"},
+      {"page CRC mismatch", "scan.e57", bad_crc, ErrorCode::kDataLoss, "CRC-32C mismatch in page 1"},
+      {"XML length 2^40", "scan.e57", e57_file(e57_root(e57_scan(xyz, "1")), section, std::uint64_t{1} << 40),
+       ErrorCode::kInvalidArgument, "XML section is not inside"},
+      {"10^12 records in a 64-byte section", "scan.e57", e57_file(e57_root(e57_scan(xyz, "1000000000000")), section),
+       ErrorCode::kInvalidArgument, "recordCount"},
+      {"prototype nested 100 000 deep", "scan.e57", e57_file(e57_root(e57_scan(nested, "1")), section),
+       ErrorCode::kInvalidArgument, "nested deeper"},
+      {"XML nested 100 000 deep outside the scans", "scan.e57", e57_file(deep_xml), ErrorCode::kInvalidArgument, "no scans"},
+      {"100 000 prototype fields", "scan.e57",
+       e57_file(e57_root(e57_scan(repeat("<f type=\"Float\"/>", 100000), "1")), section), ErrorCode::kInvalidArgument,
+       "more than 1024 fields"},
+      {"1 MiB attribute", "scan.e57", e57_file(e57_root(e57_scan(xyz, std::string(1 << 20, '9'))), section),
+       ErrorCode::kInvalidArgument, "recordCount"},
+      {"unterminated XML", "scan.e57", e57_file("<e57Root><data3D>" + std::string(100000, 'x')),
+       ErrorCode::kInvalidArgument, "bad XML"},
+      {"binary garbage after the magic", "scan.e57", "ASTM-E57" + garbage(4096, 9), ErrorCode::kInvalidArgument, ""},
+  });
 }
 
 TEST(HostileInput, UnknownContentWithoutAHint) {
