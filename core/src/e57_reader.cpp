@@ -282,8 +282,9 @@ class ScanDecoder {
     if (!io_detail::mul_fits(scan_.record_count, bits_per_record, 8 * length))
       fail("truncated: recordCount " + std::to_string(scan_.record_count) + " needs more than the " +
            std::to_string(length) + " bytes of its section");
-    // Real scans need several bytes per record; a claim of more records than bytes is trusted only as it decodes.
-    points.reserve(points.size() + std::min<std::uint64_t>(scan_.record_count, length));
+    // Real scans take 3 bytes or more per record, so reserving a record per 3 section bytes (at most 8 bytes of
+    // points per file byte) covers them; denser claims grow the vector only as records actually decode.
+    points.reserve(points.size() + std::min<std::uint64_t>(scan_.record_count, length / 3));
     for (std::uint64_t pos = scan_.data_logical; emitted_ < scan_.record_count;) {
       if (pos + 4 > end_)
         fail("truncated: the section ends after " + std::to_string(emitted_) + " of " +
