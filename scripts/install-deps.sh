@@ -10,7 +10,7 @@ PACKAGES=(
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libcpp-httplib-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-grpcio python3-protobuf
-  libpugixml-dev
+  libpugixml-dev prometheus
   gnuplot-nox yamllint python3-yaml docker-compose curl
 )
 
