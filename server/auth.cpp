@@ -16,17 +16,21 @@ bool equal_constant_time(std::string_view a, std::string_view b) {
 
 }  // namespace
 
-grpc::Status check_bearer_token(const grpc::ServerContextBase& context, const std::string& token) {
+grpc::Status check_bearer_token(std::optional<std::string_view> authorization, const std::string& token) {
   if (token.empty()) return grpc::Status::OK;
-  const auto& metadata = context.client_metadata();
-  const auto it = metadata.find("authorization");
-  if (it == metadata.end()) return {grpc::StatusCode::UNAUTHENTICATED, "missing 'authorization: Bearer' metadata"};
-  const std::string_view value(it->second.data(), it->second.size());
+  if (!authorization) return {grpc::StatusCode::UNAUTHENTICATED, "missing 'authorization: Bearer' metadata or header"};
   constexpr std::string_view kScheme = "Bearer ";
-  if (value.substr(0, kScheme.size()) != kScheme ||
-      !equal_constant_time(value.substr(kScheme.size()), token))
+  if (authorization->substr(0, kScheme.size()) != kScheme ||
+      !equal_constant_time(authorization->substr(kScheme.size()), token))
     return {grpc::StatusCode::UNAUTHENTICATED, "invalid bearer token"};
   return grpc::Status::OK;
+}
+
+grpc::Status check_bearer_token(const grpc::ServerContextBase& context, const std::string& token) {
+  const auto& metadata = context.client_metadata();
+  const auto it = metadata.find("authorization");
+  if (it == metadata.end()) return check_bearer_token(std::nullopt, token);
+  return check_bearer_token(std::string_view(it->second.data(), it->second.size()), token);
 }
 
 }  // namespace k4reg::service

@@ -1,15 +1,19 @@
-// Optional shared-secret bearer token ("authorization: Bearer <token>" metadata). Only the Registration
-// methods check it: the health service stays open so that probes (kubelet, load balancers) need no secret,
+// Optional shared-secret bearer token ("authorization: Bearer <token>" gRPC metadata or HTTP header). Only the
+// registration calls check it: the health service stays open so that probes (kubelet, load balancers) need no secret,
 // and reflection reveals only the public API.
 #pragma once
 
 #include <grpcpp/server_context.h>
 
+#include <optional>
 #include <string>
+#include <string_view>
 
 namespace k4reg::service {
 
-// OK when no token is configured or the call carries it; UNAUTHENTICATED otherwise.
+// OK when no token is configured or `authorization` (the value of the gRPC metadata or HTTP header, nullopt
+// when the call has none) carries it; UNAUTHENTICATED otherwise.
+grpc::Status check_bearer_token(std::optional<std::string_view> authorization, const std::string& token);
 grpc::Status check_bearer_token(const grpc::ServerContextBase& context, const std::string& token);
 
 }  // namespace k4reg::service

@@ -61,6 +61,7 @@ class JobQueue {
   std::size_t waiting() const;
   std::size_t running() const;
   std::size_t capacity() const { return capacity_; }
+  std::size_t workers() const { return workers_.size(); }
 
   // Called (without the queue's lock held) whenever the number of waiting jobs changes, e.g. to publish
   // readiness. May be set while the queue is in use (the health service exists only once gRPC runs).

@@ -1,8 +1,9 @@
 // k4reg-server: the k4reg.v1.Registration gRPC service (see proto/k4reg/v1/registration.proto), with
-// grpc.health.v1 health and server reflection. Configuration: server_config.h (flags or K4REG_* variables).
+// grpc.health.v1 health and server reflection, and the same API over HTTP/JSON with /metrics (http_server.h).
+// Configuration: server_config.h (flags or K4REG_* variables).
 //
-// SIGTERM / SIGINT drain: readiness goes NOT_SERVING, new calls get UNAVAILABLE, queued and running jobs
-// get --drain-grace-s to finish, then the rest are cancelled; the process exits 0.
+// SIGTERM / SIGINT drain: readiness goes NOT_SERVING (HTTP /readyz 503), new calls get UNAVAILABLE (HTTP 503),
+// queued and running jobs get --drain-grace-s to finish, then the rest are cancelled; the process exits 0.
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
@@ -15,7 +16,9 @@
 #include <sstream>
 
 #include "health.h"
+#include "http_server.h"
 #include "json_log.h"
+#include "metrics.h"
 #include "registration_service.h"
 #include "server_config.h"
 
@@ -71,8 +74,20 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
   v1::ServerInfo info;
   info.set_version(K4REG_VERSION);
   info.set_server_id(config.server_id);
-  RegistrationService service(ServiceContext{queue, memory, paths, spool, JobLimits{config.max_points, config.job_threads},
-                                             config.auth_token, std::uint64_t(config.max_upload_mb) << 20, info});
+  Metrics metrics(K4REG_VERSION);
+  const ServiceContext context{queue,
+                               memory,
+                               paths,
+                               spool,
+                               JobLimits{config.max_points, config.job_threads},
+                               config.auth_token,
+                               std::uint64_t(config.max_upload_mb) << 20,
+                               std::uint64_t(config.max_inline_mb) << 20,
+                               info,
+                               metrics};
+  RegistrationService service(context);
+  std::unique_ptr<HttpServer> http;
+  if (!config.http_listen.empty()) http = std::make_unique<HttpServer>(context, config.http_listen);
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
@@ -89,8 +104,15 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
   HealthPublisher health(*server->GetHealthCheckService(), queue);
   queue.set_on_change([&health] { health.update(); });
   health.update();  // changes before the line above
+  nlohmann::json serving{{"grpc_port", port}, {"server_id", config.server_id}};
+  if (http) {
+    http->start();
+    serving["http_port"] = http->port();
+    // Before the gRPC port file: whoever waits for that one finds this one written.
+    if (!config.http_port_file.empty()) write_port_file(config.http_port_file, http->port());
+  }
   if (!config.port_file.empty()) write_port_file(config.port_file, port);
-  log_json(spdlog::level::info, "serving", {{"grpc_port", port}, {"server_id", config.server_id}});
+  log_json(spdlog::level::info, "serving", std::move(serving));
 
   int signal_number = 0;
   sigwait(&stop_signals, &signal_number);
@@ -104,6 +126,8 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
     queue.cancel_all();
     queue.wait_idle(Clock::now() + std::chrono::seconds(10));  // cancellation takes effect within ~100 ms
   }
+  // HTTP answers of the finished jobs go out; bodies still arriving are cut.
+  if (http) http->stop();
   // Replies already handed to gRPC get this long to leave; calls without a job (an unfinished upload) are
   // cut. Idle client connections that ignore GOAWAY also hold Shutdown until the deadline.
   server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));

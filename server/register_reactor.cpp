@@ -1,6 +1,5 @@
 #include "register_reactor.h"
 
-#include "k4reg/error.h"
 #include "proto_convert.h"
 #include "status_mapping.h"
 
@@ -16,8 +15,8 @@ RegisterReactor::RegisterReactor(ServiceContext& service, grpc::CallbackServerCo
   }
   try {
     params_ = params_from_proto(request->params());
-    source_ = cloud_source(request->source(), "source");
-    target_ = cloud_source(request->target(), "target");
+    source_ = service_.cloud_source(request->source(), "source");
+    target_ = service_.cloud_source(request->target(), "target");
   } catch (...) {
     finish(status_from_current_exception());
     return;
@@ -30,20 +29,6 @@ RegisterReactor::RegisterReactor(ServiceContext& service, grpc::CallbackServerCo
   if (const grpc::Status status = service_.submit(job_, position); !status.ok()) finish(status);
 }
 
-CloudSource RegisterReactor::cloud_source(const v1::CloudInput& input, const char* role) const {
-  switch (input.kind_case()) {
-    case v1::CloudInput::kPath:
-      return service_.referenced_cloud(input.path());
-    case v1::CloudInput::kInlineCloud: {
-      const v1::InlineCloud& cloud = input.inline_cloud();
-      return {cloud.file_name().empty() ? role : cloud.file_name(), {}, cloud.data()};
-    }
-    case v1::CloudInput::KIND_NOT_SET:
-      break;
-  }
-  fail(ErrorCode::kInvalidArgument, std::string(role) + ": give either path or inline_cloud");
-}
-
 void RegisterReactor::execute(Job& job) {
   finish(run_job(service_, job, source_, target_, params_, {}, clock_, record_, *reply_));
 }
@@ -51,14 +36,14 @@ void RegisterReactor::execute(Job& job) {
 void RegisterReactor::OnCancel() {
   if (!job_) return;  // refused before queueing; already finished
   job_->token().cancel();
-  if (service_.queue.withdraw(job_.get())) finish({grpc::StatusCode::CANCELLED, "cancelled while queued"});
+  if (service_.withdraw(job_.get())) finish({grpc::StatusCode::CANCELLED, "cancelled while queued"});
 }
 
 void RegisterReactor::finish(const grpc::Status& status) {
   if (finished_.exchange(true)) return;
   record_.code = status.error_code();
   record_.error = status.error_message();
-  log_request(record_);  // before the reply leaves: a client that got its answer finds the log line
+  service_.end_request(record_);  // before the reply leaves: a client that got its answer finds the log line
   Finish(status);
 }
 

@@ -21,7 +21,6 @@ class RegisterReactor final : public grpc::ServerUnaryReactor {
   void OnDone() override;
 
  private:
-  CloudSource cloud_source(const v1::CloudInput& input, const char* role) const;
   void execute(Job& job);  // on a worker
   void finish(const grpc::Status& status);
 

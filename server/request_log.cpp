@@ -20,26 +20,22 @@ std::string new_uuid() {
                      lo & 0xFFFFFFFFFFFFull);
 }
 
-
-
 }  // namespace
 
-std::string request_id_of(const grpc::ServerContextBase& context) {
-  const auto& metadata = context.client_metadata();
-  const auto it = metadata.find("x-request-id");
-  if (it != metadata.end()) {
-    const std::string id(it->second.data(), it->second.size());
-    if (!id.empty() && id.size() <= 128 &&
-        std::all_of(id.begin(), id.end(), [](char c) { return c > 0x20 && c < 0x7F && c != '"' && c != '\\'; }))
-      return id;
-  }
+std::string request_id_or_new(std::string_view offered) {
+  if (!offered.empty() && offered.size() <= 128 &&
+      std::all_of(offered.begin(), offered.end(), [](char c) { return c > 0x20 && c < 0x7F && c != '"' && c != '\\'; }))
+    return std::string(offered);
   return new_uuid();
 }
 
 RequestRecord open_request(grpc::CallbackServerContext& context, const char* method) {
   RequestRecord record;
   record.method = method;
-  record.request_id = request_id_of(context);
+  const auto& metadata = context.client_metadata();
+  const auto offered = metadata.find("x-request-id");
+  record.request_id = request_id_or_new(offered == metadata.end() ? std::string_view()
+                                                                  : std::string_view(offered->second.data(), offered->second.size()));
   record.peer = context.peer();
   context.AddInitialMetadata("x-request-id", record.request_id);
   return record;
@@ -49,6 +45,7 @@ void log_request(const RequestRecord& r) {
   const double duration_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r.start).count();
   nlohmann::json fields{{"request_id", r.request_id},
+                        {"protocol", r.protocol},
                         {"method", r.method},
                         {"peer", r.peer},
                         {"code", status_code_name(r.code)},
@@ -57,11 +54,13 @@ void log_request(const RequestRecord& r) {
                         {"target_points", r.target_points},
                         {"queue_wait_ms", 1000.0 * r.queue_wait_s},
                         {"registration_ms", 1000.0 * r.registration_s}};
+  if (r.http_status) fields["http_status"] = r.http_status;
   if (r.upload_bytes) fields["upload_bytes"] = r.upload_bytes;
   if (r.code != grpc::StatusCode::OK) fields["error"] = r.error;
   // Client mistakes and overload are expected traffic; only server faults are warnings.
   const bool fault = r.code == grpc::StatusCode::INTERNAL || r.code == grpc::StatusCode::UNKNOWN;
-  log_json(fault ? spdlog::level::warn : spdlog::level::info, "request", std::move(fields));
+  const auto level = fault ? spdlog::level::warn : r.probe ? spdlog::level::debug : spdlog::level::info;
+  log_json(level, "request", std::move(fields));
 }
 
 }  // namespace k4reg::service

@@ -1,4 +1,5 @@
-// The access log: one line per request with its id, method, status, duration, points and queue wait.
+// The access log of both protocols: one line per request with its id, protocol, method, status, duration,
+// points and queue wait. gRPC and HTTP share the request id scheme ("x-request-id") and this format.
 #pragma once
 
 #include <grpcpp/server_context.h>
@@ -7,16 +8,21 @@
 #include <chrono>
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 namespace k4reg::service {
 
-// The request id: the caller's "x-request-id" metadata if it is a sane token (printable ASCII, at most
-// 128 characters), otherwise a new random UUID v4.
-std::string request_id_of(const grpc::ServerContextBase& context);
+// The request id: the caller's "x-request-id" (gRPC metadata or HTTP header; "" when absent) if it is a
+// sane token (printable ASCII without quotes or backslashes, at most 128 characters), otherwise a new random
+// UUID v4.
+std::string request_id_or_new(std::string_view offered);
 
-// What a call reports when it ends. Filled in by the reactor as the call goes.
+// What a call reports when it ends. Filled in by the reactor or HTTP handler as the call goes.
 struct RequestRecord {
   std::string request_id, method, peer;
+  std::string protocol = "grpc";  // or "http"
+  int http_status = 0;            // HTTP only
+  bool probe = false;             // health, metrics and API description requests: logged at debug level
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
   grpc::StatusCode code = grpc::StatusCode::OK;
   std::string error;  // status message when not OK

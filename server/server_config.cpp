@@ -12,10 +12,14 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
   app.add_option("--grpc-listen", c.grpc_listen, "gRPC address host:port (port 0 = ephemeral)")
       ->envname("K4REG_GRPC_LISTEN")
       ->capture_default_str();
-  app.add_option("--http-listen", c.http_listen, "HTTP/JSON address (reserved; not served yet)")
-      ->envname("K4REG_HTTP_LISTEN");
+  app.add_option("--http-listen", c.http_listen,
+                 "HTTP/JSON API and /metrics address host:port (port 0 = ephemeral, empty = no HTTP)")
+      ->envname("K4REG_HTTP_LISTEN")
+      ->capture_default_str();
   app.add_option("--port-file", c.port_file, "write the bound gRPC port to this file once serving")
       ->envname("K4REG_PORT_FILE");
+  app.add_option("--http-port-file", c.http_port_file, "write the bound HTTP port to this file once serving")
+      ->envname("K4REG_HTTP_PORT_FILE");
   app.add_option("--data-root", c.data_roots, "folder whose files requests may reference (repeatable; env: colon-separated)")
       ->envname("K4REG_DATA_ROOT")
       ->delimiter(':')
@@ -97,6 +101,7 @@ nlohmann::json config_to_json(const ServerConfig& c) {
   return {{"grpc_listen", c.grpc_listen},
           {"http_listen", c.http_listen},
           {"port_file", c.port_file},
+          {"http_port_file", c.http_port_file},
           {"data_roots", c.data_roots},
           {"workers", c.workers},
           {"queue_size", c.queue_size},

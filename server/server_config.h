@@ -12,8 +12,9 @@ namespace k4reg::service {
 
 struct ServerConfig {
   std::string grpc_listen = "0.0.0.0:50051";  // port 0 = ephemeral (logged and written to port_file)
-  std::string http_listen;                    // reserved for the HTTP/JSON API (not served yet)
+  std::string http_listen = "0.0.0.0:8080";   // HTTP/JSON API; port 0 = ephemeral, "" = no HTTP listener
   std::string port_file;                      // where to write the bound gRPC port, if set
+  std::string http_port_file;                 // where to write the bound HTTP port, if set
   std::vector<std::string> data_roots;        // referenced files must lie under one of these
   std::size_t workers = 0;                    // 0 = number of cores
   std::size_t queue_size = 16;                // waiting jobs beyond the running ones

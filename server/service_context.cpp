@@ -1,11 +1,15 @@
 #include "service_context.h"
 
 #include "auth.h"
+#include "k4reg/error.h"
 #include "proto_convert.h"
 #include "status_mapping.h"
+#include "status_name.h"
 
 namespace k4reg::service {
 namespace {
+
+constexpr const char* kDraining = "server is draining; retry on another replica";
 
 double seconds(CallClock::Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
@@ -14,7 +18,20 @@ double seconds(CallClock::Clock::duration d) { return std::chrono::duration<doub
 grpc::Status ServiceContext::admit(const grpc::ServerContextBase& context) const {
   grpc::Status status = check_bearer_token(context, auth_token);
   if (!status.ok()) return status;
-  if (!queue.accepting()) return {grpc::StatusCode::UNAVAILABLE, "server is draining; retry on another replica"};
+  if (!queue.accepting()) return {grpc::StatusCode::UNAVAILABLE, kDraining};
+  return grpc::Status::OK;
+}
+
+grpc::Status ServiceContext::admit(std::optional<std::string_view> authorization) const {
+  grpc::Status status = check_bearer_token(authorization, auth_token);
+  if (!status.ok()) return status;
+  if (!queue.accepting()) return {grpc::StatusCode::UNAVAILABLE, kDraining};
+  return grpc::Status::OK;
+}
+
+grpc::Status ServiceContext::readiness() const {
+  if (!queue.accepting()) return {grpc::StatusCode::UNAVAILABLE, kDraining};
+  if (queue.full()) return {grpc::StatusCode::UNAVAILABLE, "job queue full (--queue-size)"};
   return grpc::Status::OK;
 }
 
@@ -25,15 +42,43 @@ grpc::Status ServiceContext::submit(std::shared_ptr<Job> job, std::size_t& posit
     case JobQueue::Admission::kAccepted:
       return grpc::Status::OK;
     case JobQueue::Admission::kQueueFull:
+      metrics.job_rejected("queue_full");
       return {grpc::StatusCode::RESOURCE_EXHAUSTED,
               "job queue full (" + std::to_string(queue.capacity()) + " waiting, --queue-size); retry later"};
     case JobQueue::Admission::kDraining:
       break;
   }
-  return {grpc::StatusCode::UNAVAILABLE, "server is draining; retry on another replica"};
+  metrics.job_rejected("draining");
+  return {grpc::StatusCode::UNAVAILABLE, kDraining};
+}
+
+bool ServiceContext::withdraw(const Job* job) const {
+  if (!queue.withdraw(job)) return false;
+  metrics.job_cancelled();
+  return true;
 }
 
 CloudSource ServiceContext::referenced_cloud(const std::string& path) const { return {path, paths.resolve(path), {}}; }
+
+CloudSource ServiceContext::cloud_source(const v1::CloudInput& input, const char* role) const {
+  switch (input.kind_case()) {
+    case v1::CloudInput::kPath:
+      return referenced_cloud(input.path());
+    case v1::CloudInput::kInlineCloud: {
+      const v1::InlineCloud& cloud = input.inline_cloud();
+      return {cloud.file_name().empty() ? role : cloud.file_name(), {}, cloud.data()};
+    }
+    case v1::CloudInput::KIND_NOT_SET:
+      break;
+  }
+  fail(ErrorCode::kInvalidArgument, std::string(role) + ": give either path or inline_cloud");
+}
+
+void ServiceContext::end_request(const RequestRecord& record) const {
+  log_request(record);
+  metrics.observe_request(record.protocol, record.method, status_code_name(record.code),
+                          seconds(CallClock::Clock::now() - record.start), record.upload_bytes);
+}
 
 void apply_deadline(const grpc::ServerContextBase& context, CancellationToken& token) {
   const auto deadline = context.deadline();
@@ -73,8 +118,12 @@ grpc::Status run_job(const ServiceContext& service, Job& job, const CloudSource&
   clock.job_end = CallClock::Clock::now();
   record.source_points = report.source_points;
   record.target_points = report.target_points;
-  record.queue_wait_s = std::chrono::duration<double>(clock.job_start - clock.enqueued).count();
+  record.queue_wait_s = seconds(clock.job_start - clock.enqueued);
   record.registration_s = report.registration_s;
+  service.metrics.observe_job(record.queue_wait_s, seconds(clock.job_end - clock.job_start),
+                              report.source_points + report.target_points);
+  if (status.error_code() == grpc::StatusCode::CANCELLED || status.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED)
+    service.metrics.job_cancelled();
   if (status.ok()) decorate_reply(service, clock, report, record.request_id, reply);
   return status;
 }

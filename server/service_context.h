@@ -1,16 +1,19 @@
-// What both RPC reactors share: the limits, the queue and the steps every call goes through
-// (admission, deadlines, path resolution, reply decoration).
+// What both RPC reactors and the HTTP API share: the limits, the queue, the metrics and the steps every call
+// goes through (admission, deadlines, path resolution, reply decoration, the access log).
 #pragma once
 
 #include <grpcpp/server_context.h>
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 
 #include "job_queue.h"
 #include "k4reg/v1/registration.pb.h"
 #include "memory_budget.h"
+#include "metrics.h"
 #include "path_policy.h"
 #include "registration_job.h"
 #include "request_log.h"
@@ -25,15 +28,26 @@ struct ServiceContext {
   SpoolDir& spool;
   JobLimits limits;
   std::string auth_token;
-  std::uint64_t max_upload_bytes = 0;
+  std::uint64_t max_upload_bytes = 0;  // per uploaded file (RegisterStream, HTTP multipart)
+  std::uint64_t max_inline_bytes = 0;  // per unary request (Register, HTTP JSON)
   v1::ServerInfo server_info;
+  Metrics& metrics;
 
-  // Auth, then draining: UNAUTHENTICATED / UNAVAILABLE, else OK.
+  // Auth, then draining: UNAUTHENTICATED / UNAVAILABLE, else OK. `authorization` as in check_bearer_token.
   grpc::Status admit(const grpc::ServerContextBase& context) const;
+  grpc::Status admit(std::optional<std::string_view> authorization) const;
+  // Readiness (gRPC "readiness" health, HTTP /readyz): UNAVAILABLE while draining or while the queue is full.
+  grpc::Status readiness() const;
   // Queues the job; RESOURCE_EXHAUSTED when the queue is full, UNAVAILABLE when draining.
   grpc::Status submit(std::shared_ptr<Job> job, std::size_t& position) const;
+  // Takes a job out of the queue before a worker picks it up (JobQueue::withdraw); true = it will never run.
+  bool withdraw(const Job* job) const;
   // A file reference as the worker will read it (throws k4reg::Error, see PathPolicy::resolve).
   CloudSource referenced_cloud(const std::string& path) const;
+  // A RegisterRequest's cloud: a reference or inline bytes (which the request owns). Throws k4reg::Error.
+  CloudSource cloud_source(const v1::CloudInput& input, const char* role) const;
+  // Ends a call of either protocol: the access-log line and the request metrics.
+  void end_request(const RequestRecord& record) const;
 };
 
 // The client's deadline becomes the job's deadline, so an expired call stops its CPU work.
@@ -49,8 +63,9 @@ struct CallClock {
 void decorate_reply(const ServiceContext& service, const CallClock& clock, const JobReport& report,
                     const std::string& request_id, v1::RegisterResponse& reply);
 
-// The worker's side of a call, the same for both RPCs: runs the registration, times it on `clock`, notes
-// points and times in `record`, and on success fills and decorates `reply`. Returns the call's status.
+// The worker's side of a call, the same for both RPCs and HTTP: runs the registration, times it on `clock`,
+// notes points and times in `record` and the metrics, and on success fills and decorates `reply`. Returns
+// the call's status.
 grpc::Status run_job(const ServiceContext& service, Job& job, const CloudSource& source, const CloudSource& target,
                      const RegistrationParams& params, const StageListener& listener, CallClock& clock,
                      RequestRecord& record, v1::RegisterResponse& reply);

@@ -43,4 +43,42 @@ grpc::Status status_from_current_exception() {
   }
 }
 
+int to_http_status(grpc::StatusCode code, bool queue_full) {
+  switch (code) {
+    case grpc::StatusCode::OK:
+      return 200;
+    case grpc::StatusCode::INVALID_ARGUMENT:
+    case grpc::StatusCode::OUT_OF_RANGE:
+    case grpc::StatusCode::DATA_LOSS:  // the bytes received are damaged: a client-side problem
+      return 400;
+    case grpc::StatusCode::UNAUTHENTICATED:
+      return 401;
+    case grpc::StatusCode::PERMISSION_DENIED:
+      return 403;
+    case grpc::StatusCode::NOT_FOUND:
+      return 404;
+    case grpc::StatusCode::UNIMPLEMENTED:  // over HTTP: another method on a known route
+      return 405;
+    case grpc::StatusCode::ALREADY_EXISTS:
+    case grpc::StatusCode::ABORTED:
+      return 409;
+    case grpc::StatusCode::RESOURCE_EXHAUSTED:
+      return queue_full ? 429 : 413;
+    case grpc::StatusCode::FAILED_PRECONDITION:  // valid clouds, no alignment found
+      return 422;
+    // An HTTP client cannot cancel a job (a disconnect is not seen while it runs): a cancelled job was
+    // stopped by the drain, and the request may succeed on another replica.
+    case grpc::StatusCode::CANCELLED:
+    case grpc::StatusCode::UNAVAILABLE:
+      return 503;
+    case grpc::StatusCode::DEADLINE_EXCEEDED:  // params.time_budget_s ran out
+      return 504;
+    case grpc::StatusCode::UNKNOWN:
+    case grpc::StatusCode::INTERNAL:
+    case grpc::StatusCode::DO_NOT_USE:
+      break;
+  }
+  return 500;
+}
+
 }  // namespace k4reg::service

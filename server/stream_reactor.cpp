@@ -211,7 +211,7 @@ void StreamReactor::finish(const grpc::Status& status) {
     for (Upload& upload : uploads_) upload.file.reset();
     record_.code = status.error_code();
     record_.error = status.error_message();
-    log_request(record_);  // before the status leaves: a client that got its answer finds the log line
+    service_.end_request(record_);  // before the status leaves: a client that got its answer finds the log line
     if (writing_) return;  // OnWriteDone finishes once the outbox is empty
     finished_ = true;
   }
@@ -227,7 +227,7 @@ void StreamReactor::OnCancel() {
   }
   if (!job) return;  // still uploading: the pending read fails and finishes the call
   job->token().cancel();
-  if (service_.queue.withdraw(job.get())) finish({grpc::StatusCode::CANCELLED, "cancelled while queued"});
+  if (service_.withdraw(job.get())) finish({grpc::StatusCode::CANCELLED, "cancelled while queued"});
 }
 
 void StreamReactor::OnDone() { delete this; }

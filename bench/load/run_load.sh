@@ -44,7 +44,7 @@ trap 'stop_servers; rm -rf "$work"' EXIT
 # start_server NAME WORKERS: a server on an ephemeral loopback port; sets $address.
 start_server() {
   local name=$1 workers=$2
-  "$bin/k4reg-server" --grpc-listen 127.0.0.1:0 --port-file "$work/$name.port" --spool-dir "$work" \
+  "$bin/k4reg-server" --grpc-listen 127.0.0.1:0 --port-file "$work/$name.port" --http-listen '' --spool-dir "$work" \
     --data-root "$root/tests/data/bunny" --workers "$workers" --queue-size 64 --server-id "$name" \
     --log-level warn 2>"$work/$name.log" &
   server_pids+=($!)

@@ -20,36 +20,11 @@ extern char** environ;
 namespace k4reg::test {
 namespace {
 
-struct CommandRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-// Runs build/bin/k4reg with `args` (stdout and stderr to files, so neither pipe can fill up) and an environment
-// without the caller's K4REG_* variables plus `env`.
+// Runs build/bin/k4reg with `args` (see run_command).
 CommandRun k4reg(const std::vector<std::string>& args, const std::map<std::string, std::string>& env = {}) {
-  TempDir dir;
-  const fs::path out = dir.path() / "out", err = dir.path() / "err";
   std::vector<std::string> arguments{K4REG_BIN_DIR "/k4reg"};
   arguments.insert(arguments.end(), args.begin(), args.end());
-  ExecVectors exec = exec_vectors(std::move(arguments), env);
-
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int out_fd = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int err_fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(out_fd, STDOUT_FILENO);
-    dup2(err_fd, STDERR_FILENO);
-    execve(exec.argv[0], exec.argv.data(), exec.envp.data());
-    _exit(127);
-  }
-  int status = 0;
-  waitpid(pid, &status, 0);
-  CommandRun run;
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  run.out = read_file(out);
-  run.err = read_file(err);
-  return run;
+  return run_command(std::move(arguments), env);
 }
 
 std::vector<std::string> lines(const std::string& text) {

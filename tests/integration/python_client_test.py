@@ -37,7 +37,8 @@ def start_server(binary, data_dir, work_dir):
     port_file = os.path.join(work_dir, "port")
     log = open(os.path.join(work_dir, "server.log"), "w")
     process = subprocess.Popen([binary, "--grpc-listen", "127.0.0.1:0", "--port-file", port_file,
-                                "--data-root", data_dir, "--workers", "1", "--spool-dir", work_dir],
+                                "--http-listen", "", "--data-root", data_dir, "--workers", "1",
+                                "--spool-dir", work_dir],
                                stderr=log)
     deadline = time.monotonic() + 20
     while not os.path.exists(port_file):

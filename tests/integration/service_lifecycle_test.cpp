@@ -14,21 +14,6 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// Every call gets a deadline, so a regression fails the test instead of hanging it.
-std::unique_ptr<grpc::ClientContext> context_with_deadline() {
-  auto context = std::make_unique<grpc::ClientContext>();
-  set_timeout(*context, 90s);
-  return context;
-}
-
-v1::UploadHeader reference_header(const v1::RegistrationParams& params) {
-  v1::UploadHeader header;
-  header.mutable_source()->set_path("bun045.ply");
-  header.mutable_target()->set_path("bun000.ply");
-  *header.mutable_params() = params;
-  return header;
-}
-
 grpc::Status register_once(const ServerProcess& server, const v1::RegistrationParams& params,
                            v1::RegisterResponse& reply, std::chrono::milliseconds timeout = 120s) {
   grpc::ClientContext context;
@@ -54,9 +39,9 @@ TEST(Queue, FullQueueIsResourceExhaustedAtOnceAndReadinessDrops) {
   ServerProcess server({"--data-root", bunny_dir().string(), "--workers", "1", "--queue-size", "1"});
   auto stub = server.stub();
   auto running_context = context_with_deadline(), queued_context = context_with_deadline();
-  StreamCall running(*stub, *running_context, reference_header(slow_params(3)), {});
+  StreamCall running(*stub, *running_context, bunny_reference_header(slow_params(3)), {});
   ASSERT_TRUE(running.wait_for_stage("load", v1::StageEvent::PHASE_STARTED));
-  StreamCall queued(*stub, *queued_context, reference_header(quick_params()), {});
+  StreamCall queued(*stub, *queued_context, bunny_reference_header(quick_params()), {});
   ASSERT_TRUE(queued.wait_for_queued());
   EXPECT_EQ(queued.events().back().queued().position(), 0u);
 
@@ -110,7 +95,7 @@ TEST(Cancellation, CancellingARunningJobFreesTheWorker) {
   ServerProcess server({"--data-root", bunny_dir().string(), "--workers", "1"});
   auto stub = server.stub();
   auto context = context_with_deadline();
-  StreamCall slow(*stub, *context, reference_header(slow_params(120)), {});
+  StreamCall slow(*stub, *context, bunny_reference_header(slow_params(120)), {});
   ASSERT_TRUE(slow.wait_for_stage("matching", v1::StageEvent::PHASE_STARTED));
   context->TryCancel();
   EXPECT_EQ(slow.finish().error_code(), grpc::StatusCode::CANCELLED);
@@ -126,16 +111,16 @@ TEST(Cancellation, CancellingAQueuedJobTakesItOutOfTheQueue) {
   ServerProcess server({"--data-root", bunny_dir().string(), "--workers", "1", "--queue-size", "1"});
   auto stub = server.stub();
   auto running_context = context_with_deadline(), queued_context = context_with_deadline();
-  StreamCall running(*stub, *running_context, reference_header(slow_params(120)), {});
+  StreamCall running(*stub, *running_context, bunny_reference_header(slow_params(120)), {});
   ASSERT_TRUE(running.wait_for_stage("load", v1::StageEvent::PHASE_STARTED));
-  StreamCall queued(*stub, *queued_context, reference_header(quick_params()), {});
+  StreamCall queued(*stub, *queued_context, bunny_reference_header(quick_params()), {});
   ASSERT_TRUE(queued.wait_for_queued());
   queued_context->TryCancel();
   EXPECT_EQ(queued.finish().error_code(), grpc::StatusCode::CANCELLED);
   // Its slot is free again while the first job still runs.
   ASSERT_TRUE(becomes(server, "readiness", "SERVING"));
   auto next_context = context_with_deadline();
-  StreamCall next(*stub, *next_context, reference_header(quick_params()), {});
+  StreamCall next(*stub, *next_context, bunny_reference_header(quick_params()), {});
   ASSERT_TRUE(next.wait_for_queued());
   running_context->TryCancel();
   EXPECT_EQ(running.finish().error_code(), grpc::StatusCode::CANCELLED);
@@ -186,7 +171,7 @@ TEST(Drain, JobsOverTheGracePeriodAreCancelled) {
   ServerProcess server({"--data-root", bunny_dir().string(), "--workers", "1", "--drain-grace-s", "0.5"});
   auto stub = server.stub();
   auto context = context_with_deadline();
-  StreamCall running(*stub, *context, reference_header(slow_params(120)), {});
+  StreamCall running(*stub, *context, bunny_reference_header(slow_params(120)), {});
   ASSERT_TRUE(running.wait_for_stage("matching", v1::StageEvent::PHASE_STARTED));
   const auto start = std::chrono::steady_clock::now();
   server.signal(SIGINT);

@@ -17,15 +17,8 @@ namespace {
 
 TEST(SimulatedScans, LabPairByReferenceMatchesInProcessAndGroundTruth) {
   TempDir data;
-  const sim::Scene lab = sim::make_scene("lab");
-  sim::ScanParams scan;
-  scan.points = 300000;
-  scan.seed = 11;
-  const sim::SimulatedScan source = sim::simulate_scan(lab, 0, scan);
-  scan.seed = 12;
-  const sim::SimulatedScan target = sim::simulate_scan(lab, 2, scan);
-  write_cloud((data.path() / "lab0.ply").string(), source.cloud);
-  write_cloud((data.path() / "lab2.ply").string(), target.cloud);
+  const LabPair lab = simulate_lab_pair(data.path(), 300000);
+  const sim::SimulatedScan &source = lab.source, &target = lab.target;
 
   v1::RegisterRequest request;
   request.mutable_source()->set_path("lab0.ply");

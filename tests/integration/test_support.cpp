@@ -6,7 +6,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -14,7 +16,9 @@
 
 #include "k4reg/crc32c.h"
 #include "grpc/health/v1/health.grpc.pb.h"
+#include "k4reg/cloud_io.h"
 #include "k4reg/gt_pairs.h"
+#include "sim/scene.h"
 
 extern char** environ;
 
@@ -32,6 +36,28 @@ std::string read_file(const fs::path& path) {
 
 void write_file(const fs::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;
+}
+
+CommandRun run_command(std::vector<std::string> arguments, const std::map<std::string, std::string>& env) {
+  TempDir dir;
+  const fs::path out = dir.path() / "out", err = dir.path() / "err";
+  ExecVectors exec = exec_vectors(std::move(arguments), env);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int out_fd = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err_fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(out_fd, STDOUT_FILENO);
+    dup2(err_fd, STDERR_FILENO);
+    execve(exec.argv[0], exec.argv.data(), exec.envp.data());
+    _exit(127);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  CommandRun run;
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  run.out = read_file(out);
+  run.err = read_file(err);
+  return run;
 }
 
 TempDir::TempDir() {
@@ -59,9 +85,13 @@ ExecVectors exec_vectors(std::vector<std::string> arguments, const std::map<std:
 }
 
 ServerProcess::ServerProcess(const std::vector<std::string>& args, const std::map<std::string, std::string>& env) {
-  const fs::path port_file = work_.path() / "port", log_file = work_.path() / "server.log";
+  const fs::path port_file = work_.path() / "port", http_port_file = work_.path() / "http_port",
+                 log_file = work_.path() / "server.log";
   std::vector<std::string> arguments{K4REG_BIN_DIR "/k4reg-server", "--grpc-listen", "127.0.0.1:0",
                                      "--port-file", port_file.string(), "--spool-dir", (work_.path() / "spool").string()};
+  const bool own_http = std::find(args.begin(), args.end(), "--http-listen") != args.end();
+  if (!own_http)
+    arguments.insert(arguments.end(), {"--http-listen", "127.0.0.1:0", "--http-port-file", http_port_file.string()});
   arguments.insert(arguments.end(), args.begin(), args.end());
   ExecVectors exec = exec_vectors(std::move(arguments), env);
   const int log_fd = ::open(log_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -83,6 +113,7 @@ ServerProcess::ServerProcess(const std::vector<std::string>& args, const std::ma
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   port_ = std::stoi(read_file(port_file));
+  if (!own_http) http_port_ = std::stoi(read_file(http_port_file));  // written before the gRPC port file
 }
 
 ServerProcess::~ServerProcess() {
@@ -96,6 +127,12 @@ std::shared_ptr<grpc::Channel> ServerProcess::channel() const {
 }
 
 std::unique_ptr<v1::Registration::Stub> ServerProcess::stub() const { return v1::Registration::NewStub(channel()); }
+
+httplib::Client ServerProcess::http() const {
+  httplib::Client client("127.0.0.1", http_port_);
+  client.set_read_timeout(std::chrono::minutes(2));
+  return client;
+}
 
 std::size_t ServerProcess::spooled_files() const {
   std::size_t count = 0;
@@ -164,6 +201,36 @@ v1::RegisterRequest bunny_request(const v1::RegistrationParams& params) {
   request.mutable_target()->set_path("bun000.ply");
   *request.mutable_params() = params;
   return request;
+}
+
+v1::UploadHeader bunny_reference_header(const v1::RegistrationParams& params) {
+  v1::UploadHeader header;
+  header.mutable_source()->set_path("bun045.ply");
+  header.mutable_target()->set_path("bun000.ply");
+  *header.mutable_params() = params;
+  return header;
+}
+
+v1::RegisterRequest sphere_request() {
+  v1::RegisterRequest request;
+  request.mutable_source()->mutable_inline_cloud()->set_data(sphere_xyz());
+  request.mutable_source()->mutable_inline_cloud()->set_file_name("sphere.xyz");
+  request.mutable_target()->mutable_inline_cloud()->set_data(sphere_xyz());
+  request.mutable_params()->set_min_scale_m(0.2);
+  return request;
+}
+
+LabPair simulate_lab_pair(const fs::path& dir, std::size_t points) {
+  const sim::Scene lab = sim::make_scene("lab");
+  sim::ScanParams scan;
+  scan.points = points;
+  scan.seed = 11;
+  LabPair pair{sim::simulate_scan(lab, 0, scan), {}, dir / "lab0.ply", dir / "lab2.ply"};
+  scan.seed = 12;
+  pair.target = sim::simulate_scan(lab, 2, scan);
+  write_cloud(pair.source_file.string(), pair.source.cloud);
+  write_cloud(pair.target_file.string(), pair.target.cloud);
+  return pair;
 }
 
 std::string sphere_xyz() {
@@ -276,6 +343,92 @@ std::string health_status(const ServerProcess& server, const std::string& servic
 
 void set_timeout(grpc::ClientContext& context, std::chrono::milliseconds timeout) {
   context.set_deadline(std::chrono::system_clock::now() + timeout);
+}
+
+std::unique_ptr<grpc::ClientContext> context_with_deadline(std::chrono::seconds timeout) {
+  auto context = std::make_unique<grpc::ClientContext>();
+  set_timeout(*context, timeout);
+  return context;
+}
+
+FullQueue::FullQueue(const ServerProcess& server, const std::string& running_stage) : stub_(server.stub()) {
+  running_ = std::make_unique<StreamCall>(*stub_, *running_context_, bunny_reference_header(slow_params(3)), StreamUpload{});
+  if (!running_->wait_for_stage(running_stage, v1::StageEvent::PHASE_STARTED))
+    throw std::runtime_error("the slow job did not reach " + running_stage);
+  queued_ = std::make_unique<StreamCall>(*stub_, *queued_context_, bunny_reference_header(quick_params()), StreamUpload{});
+  if (!queued_->wait_for_queued()) throw std::runtime_error("the quick job was not queued");
+}
+
+std::string HttpReply::header(const std::string& name) const {
+  const auto it = headers.find(name);
+  return it == headers.end() ? std::string() : it->second;
+}
+
+nlohmann::json HttpReply::json() const { return nlohmann::json::parse(body, nullptr, false); }
+
+namespace {
+
+std::string shell_quoted(const std::string& text) {
+  std::string quoted = "'";
+  for (const char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
+std::string lower_case(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
+  return text;
+}
+
+}  // namespace
+
+HttpReply reply_of(const httplib::Result& result) {
+  if (!result) throw std::runtime_error("no HTTP answer: " + httplib::to_string(result.error()));
+  HttpReply reply;
+  reply.status = result->status;
+  reply.body = result->body;
+  for (const auto& [name, value] : result->headers) reply.headers[lower_case(name)] = value;
+  return reply;
+}
+
+bool http_status_becomes(const ServerProcess& server, const std::string& path, int status) {
+  httplib::Client client = server.http();
+  for (auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10); std::chrono::steady_clock::now() < end;
+       std::this_thread::sleep_for(std::chrono::milliseconds(20)))
+    if (reply_of(client.Get(path)).status == status) return true;
+  return false;
+}
+
+HttpReply curl(const std::vector<std::string>& args, const std::string& stdin_command) {
+  TempDir dir;
+  const fs::path headers = dir.path() / "headers", body = dir.path() / "body";
+  std::vector<std::string> command{"curl", "-sS", "-D", headers.string(), "-o", body.string(), "-w", "%{http_code}"};
+  command.insert(command.end(), args.begin(), args.end());
+  std::string line = stdin_command.empty() ? "exec" : stdin_command + " |";
+  for (const std::string& word : command) line.append(" ").append(shell_quoted(word));
+  const CommandRun run = run_command({"/bin/sh", "-c", line});
+  HttpReply reply;
+  reply.status = std::atoi(run.out.c_str());
+  if (run.exit_code != 0) throw std::runtime_error("curl failed (" + std::to_string(run.exit_code) + "): " + run.err);
+  reply.body = read_file(body);
+  // The last header block is the final answer (a "100 Continue" block may come first).
+  std::istringstream text(read_file(headers));
+  for (std::string header; std::getline(text, header);) {
+    if (!header.empty() && header.back() == '\r') header.pop_back();
+    if (header.rfind("HTTP/", 0) == 0) reply.headers.clear();
+    const auto colon = header.find(':');
+    if (colon == std::string::npos) continue;
+    const std::string name = lower_case(header.substr(0, colon));
+    const auto value = header.find_first_not_of(' ', colon + 1);
+    reply.headers[name] = value == std::string::npos ? std::string() : header.substr(value);
+  }
+  return reply;
+}
+
+std::size_t resident_kib(pid_t pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmRSS:", 0) == 0) return std::stoul(line.substr(6));
+  throw std::runtime_error("no VmRSS for pid " + std::to_string(pid));
 }
 
 }  // namespace k4reg::test

@@ -16,7 +16,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "http_lib.h"
 #include "k4reg/v1/registration.grpc.pb.h"
+#include "sim/scanner.h"
 
 namespace k4reg::test {
 
@@ -34,6 +36,14 @@ ExecVectors exec_vectors(std::vector<std::string> arguments, const std::map<std:
 std::string read_file(const fs::path& path);
 void write_file(const fs::path& path, const std::string& bytes);
 
+struct CommandRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+// Runs `arguments` (argv[0] a path) with stdout and stderr to files, so neither pipe can fill up, and an
+// environment without the caller's K4REG_* variables plus `env`.
+CommandRun run_command(std::vector<std::string> arguments, const std::map<std::string, std::string>& env = {});
+
 // A fresh folder under the system temp dir, removed with its contents.
 class TempDir {
  public:
@@ -47,7 +57,8 @@ class TempDir {
   fs::path path_;
 };
 
-// The real binary, started with `args` plus --grpc-listen 127.0.0.1:0, --port-file and a private
+// The real binary, started with `args` plus --grpc-listen and --http-listen on 127.0.0.1:0 (never a fixed
+// port, so ctest -j works; --http-listen only unless `args` has its own), their port files and a private
 // --spool-dir; stderr (the JSON log) goes to a file. Killed if still running when destroyed.
 class ServerProcess {
  public:
@@ -58,9 +69,13 @@ class ServerProcess {
 
   int port() const { return port_; }
   std::string address() const { return "127.0.0.1:" + std::to_string(port_); }
+  int http_port() const { return http_port_; }
+  std::string http_url() const { return "http://127.0.0.1:" + std::to_string(http_port_); }
   pid_t pid() const { return pid_; }
   std::shared_ptr<grpc::Channel> channel() const;
   std::unique_ptr<v1::Registration::Stub> stub() const;
+  // A cpp-httplib client of the HTTP API that waits up to two minutes for an answer (jobs run meanwhile).
+  httplib::Client http() const;
   // The folder given as --spool-dir; the server keeps its uploads in a subfolder of it.
   const fs::path& spool_parent() const { return work_.path(); }
   // Regular files anywhere below the spool parent (uploads in flight or left behind).
@@ -76,7 +91,7 @@ class ServerProcess {
  private:
   TempDir work_;
   pid_t pid_ = -1;
-  int port_ = 0;
+  int port_ = 0, http_port_ = 0;
   bool exited_ = false;
 };
 
@@ -88,8 +103,19 @@ v1::RegistrationParams slow_params(double seconds);
 v1::RegistrationParams quick_params();
 
 v1::RegisterRequest bunny_request(const v1::RegistrationParams& params);
+// RegisterStream's header for the bunny pair by reference (nothing to upload).
+v1::UploadHeader bunny_reference_header(const v1::RegistrationParams& params);
 // Points on a sphere as XYZ text: smooth, so it yields too few keypoints at min_scale_m 0.2.
 std::string sphere_xyz();
+// Two inline spheres at min_scale_m 0.2: valid clouds that cannot be aligned (FAILED_PRECONDITION).
+v1::RegisterRequest sphere_request();
+
+// Stations 0 and 2 of the simulated lab (seeds 11 and 12), written to `dir` as lab0.ply and lab2.ply.
+struct LabPair {
+  sim::SimulatedScan source, target;
+  fs::path source_file, target_file;
+};
+LabPair simulate_lab_pair(const fs::path& dir, std::size_t points);
 
 Eigen::Matrix4d to_matrix(const google::protobuf::RepeatedField<double>& values);
 // Ground truth T_target_source of a pair from tests/data/bunny/gt_pairs.log.
@@ -133,5 +159,43 @@ std::string health_status(const ServerProcess& server, const std::string& servic
 
 // Deadline helper for client contexts.
 void set_timeout(grpc::ClientContext& context, std::chrono::milliseconds timeout);
+// Every call gets a deadline, so a regression fails the test instead of hanging it.
+std::unique_ptr<grpc::ClientContext> context_with_deadline(std::chrono::seconds timeout = std::chrono::seconds(90));
+
+// Fills the queue of a server run with --workers 1 --queue-size 1 with gRPC streams, whose events tell when: a
+// slow job (~3 s on one core) that has started `running_stage`, and a quick one waiting behind it.
+class FullQueue {
+ public:
+  explicit FullQueue(const ServerProcess& server, const std::string& running_stage = "load");
+  StreamCall& running() { return *running_; }
+  StreamCall& queued() { return *queued_; }
+  grpc::ClientContext& running_context() { return *running_context_; }
+  grpc::ClientContext& queued_context() { return *queued_context_; }
+
+ private:
+  std::unique_ptr<v1::Registration::Stub> stub_;
+  std::unique_ptr<grpc::ClientContext> running_context_ = context_with_deadline(), queued_context_ = context_with_deadline();
+  std::unique_ptr<StreamCall> running_, queued_;
+};
+
+// An HTTP answer as either client saw it; header names in lower case.
+struct HttpReply {
+  int status = 0;
+  std::map<std::string, std::string> headers;
+  std::string body;
+  std::string header(const std::string& name) const;
+  nlohmann::json json() const;
+};
+// What cpp-httplib's client got; throws if it got no answer at all.
+HttpReply reply_of(const httplib::Result& result);
+// Polls GET `path` until it answers `status` (server-side state that follows a client action asynchronously:
+// a signal, a cancellation); false if it does not within 10 s.
+bool http_status_becomes(const ServerProcess& server, const std::string& path, int status);
+// `curl -sS` with `args` (the URL among them). `stdin_command`, if given, is a shell command whose output is
+// curl's stdin (`-T -`, `-d @-`): large bodies come from a generator, never from a file.
+HttpReply curl(const std::vector<std::string>& args, const std::string& stdin_command = "");
+
+// Resident memory of a process, from /proc/<pid>/status.
+std::size_t resident_kib(pid_t pid);
 
 }  // namespace k4reg::test

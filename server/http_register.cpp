@@ -1,0 +1,117 @@
+#include "http_register.h"
+
+#include <fmt/format.h>
+
+#include <future>
+#include <memory>
+
+#include "http_json.h"
+#include "http_upload.h"
+#include "k4reg/error.h"
+#include "proto_convert.h"
+#include "status_mapping.h"
+
+namespace k4reg::service {
+namespace {
+
+// Part headers and parameter fields around the two files of a multipart body.
+constexpr std::uint64_t kFormOverheadBytes = 1 << 20;
+// The JSON around base64-encoded inline clouds.
+constexpr std::uint64_t kJsonOverheadBytes = 64 << 10;
+
+enum class BodyKind { kJson, kMultipart };
+
+BodyKind body_kind(const httplib::Request& request) {
+  if (request.is_multipart_form_data()) return BodyKind::kMultipart;
+  const std::string type = request.get_header_value("Content-Type");
+  if (type.rfind(kJsonContentType, 0) == 0) return BodyKind::kJson;
+  fail(ErrorCode::kInvalidArgument,
+       "unsupported Content-Type '" + type + "': send application/json or multipart/form-data");
+}
+
+// Inline clouds travel base64-encoded in JSON (4 characters per 3 bytes).
+std::uint64_t json_limit(const ServiceContext& service) {
+  return (service.max_inline_bytes + 2) / 3 * 4 + kJsonOverheadBytes;
+}
+
+std::uint64_t multipart_limit(const ServiceContext& service) { return 2 * service.max_upload_bytes + kFormOverheadBytes; }
+
+// Queues the job like the RPCs do and waits for it on this (cpp-httplib) thread. `queue_full` tells a full
+// queue (429) from the other RESOURCE_EXHAUSTED refusals (413).
+grpc::Status run_and_wait(const ServiceContext& service, const CloudSource& source, const CloudSource& target,
+                          const RegistrationParams& params, CallClock& clock, RequestRecord& record,
+                          v1::RegisterResponse& reply, bool& queue_full) {
+  // Owned by the job as well: the worker may still be inside set_value when this thread wakes up.
+  auto done = std::make_shared<std::promise<grpc::Status>>();
+  std::future<grpc::Status> finished = done->get_future();
+  auto job = std::make_shared<Job>([&, done](Job& self) {
+    done->set_value(run_job(service, self, source, target, params, {}, clock, record, reply));
+  });
+  clock.enqueued = CallClock::Clock::now();
+  std::size_t position = 0;
+  if (const grpc::Status status = service.submit(job, position); !status.ok()) {
+    queue_full = status.error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED;
+    return status;
+  }
+  // A queued job always runs, if only to notice its cancellation (JobQueue::stop), so this wait ends.
+  return finished.get();
+}
+
+}  // namespace
+
+grpc::Status check_register_headers(const ServiceContext& service, const httplib::Request& request) {
+  if (grpc::Status status = service.admit(authorization_header(request)); !status.ok()) return status;
+  try {
+    const bool multipart = body_kind(request) == BodyKind::kMultipart;
+    const std::uint64_t limit = multipart ? multipart_limit(service) : json_limit(service);
+    const std::uint64_t declared = request.get_header_value<std::uint64_t>("Content-Length");
+    if (declared > limit)
+      fail(ErrorCode::kResourceExhausted,
+           fmt::format("request body of {} bytes, more than the {} limit of {} bytes ({})", declared,
+                       multipart ? "multipart" : "JSON", limit,
+                       multipart ? "2 files of --max-upload-mb" : "--max-inline-mb of base64 clouds"));
+  } catch (...) {
+    return status_from_current_exception();
+  }
+  return grpc::Status::OK;
+}
+
+void handle_register(const ServiceContext& service, HttpExchange& exchange) {
+  if (const grpc::Status status = check_register_headers(service, exchange.request); !status.ok()) {
+    exchange.fail(status);
+    return;
+  }
+  CallClock clock;
+  v1::RegisterRequest request;  // owns inline cloud bytes
+  UploadForm form;              // owns spool files
+  RegistrationParams params;
+  CloudSource source, target;
+  try {
+    if (body_kind(exchange.request) == BodyKind::kJson) {
+      from_json(exchange.body.read_all(json_limit(service)), request);
+      params = params_from_proto(request.params());
+      source = service.cloud_source(request.source(), "source");
+      target = service.cloud_source(request.target(), "target");
+    } else {
+      clock.upload_start = CallClock::Clock::now();
+      form = read_upload_form(exchange.body, service);
+      clock.upload_end = CallClock::Clock::now();
+      params = params_from_proto(form.params);
+      source = form.clouds[0];
+      target = form.clouds[1];
+    }
+  } catch (...) {
+    exchange.fail(status_from_current_exception());
+    return;
+  }
+  v1::RegisterResponse reply;
+  bool queue_full = false;
+  const grpc::Status status = run_and_wait(service, source, target, params, clock, exchange.record, reply, queue_full);
+  if (!status.ok()) {
+    exchange.fail(status, queue_full);
+    return;
+  }
+  exchange.reply(reply);
+}
+
+}  // namespace k4reg::service

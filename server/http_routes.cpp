@@ -1,0 +1,61 @@
+#include "http_routes.h"
+
+#include "grpc/health/v1/health.pb.h"
+#include "http_json.h"
+#include "http_register.h"
+#include "metrics.h"
+
+namespace k4reg::service {
+namespace {
+
+// The same message as the gRPC health service answers: {"status": "SERVING"}.
+grpc::health::v1::HealthCheckResponse serving() {
+  grpc::health::v1::HealthCheckResponse health;
+  health.set_status(grpc::health::v1::HealthCheckResponse::SERVING);
+  return health;
+}
+
+// Liveness: answering at all is the test.
+void handle_healthz(const ServiceContext&, HttpExchange& exchange) { exchange.reply(serving()); }
+
+// Readiness, as the gRPC "readiness" health service: 503 while draining or while the job queue is full.
+void handle_readyz(const ServiceContext& service, HttpExchange& exchange) {
+  if (const grpc::Status status = service.readiness(); !status.ok()) {
+    exchange.fail(status);
+    return;
+  }
+  exchange.reply(serving());
+}
+
+void handle_version(const ServiceContext& service, HttpExchange& exchange) { exchange.reply(service.server_info); }
+
+void handle_openapi(const ServiceContext&, HttpExchange& exchange) {
+  exchange.reply(200, std::string(openapi_document()), kJsonContentType);
+}
+
+void handle_metrics(const ServiceContext& service, HttpExchange& exchange) {
+  Metrics::Snapshot snapshot;
+  snapshot.queue_depth = service.queue.waiting();
+  snapshot.queue_capacity = service.queue.capacity();
+  snapshot.workers_busy = service.queue.running();
+  snapshot.workers = service.queue.workers();
+  snapshot.memory_reserved_bytes = service.memory.in_use();
+  exchange.reply(200, service.metrics.exposition(snapshot), kPrometheusContentType);
+}
+
+constexpr HttpRoute kRoutes[] = {
+    {"POST", "/v1/register", false, check_register_headers, handle_register},
+    {"GET", "/v1/version", false, nullptr, handle_version},
+    {"GET", "/healthz", true, nullptr, handle_healthz},
+    {"GET", "/readyz", true, nullptr, handle_readyz},
+    {"GET", "/metrics", true, nullptr, handle_metrics},
+    {"GET", "/openapi.json", true, nullptr, handle_openapi},
+};
+
+}  // namespace
+
+std::span<const HttpRoute> http_routes() { return kRoutes; }
+
+std::string route_name(const HttpRoute& route) { return std::string(route.method) + " " + std::string(route.path); }
+
+}  // namespace k4reg::service

@@ -1,0 +1,159 @@
+#include "http_server.h"
+
+#include <chrono>
+#include <stdexcept>
+
+#include "status_mapping.h"
+
+namespace k4reg::service {
+namespace {
+
+// Threads beyond one per admissible job: probes, metrics and refusals must get through a busy server.
+constexpr std::size_t kSpareThreads = 8;
+// Idle keep-alive connections hold a thread this long, and stop() may wait for them as long.
+constexpr time_t kKeepAliveTimeoutS = 2;
+// A client may pause this long while sending a body.
+constexpr time_t kReadTimeoutS = 30;
+constexpr const char* kUnmatchedRoute = "unmatched";
+
+std::string regex_escaped(std::string_view literal) {
+  std::string pattern;
+  for (const char c : literal) {
+    if (std::string_view(".^$|()[]{}*+?\\").find(c) != std::string_view::npos) pattern += '\\';
+    pattern += c;
+  }
+  return pattern;
+}
+
+// "0.0.0.0:8080", "[::]:8080" -> host and port.
+std::pair<std::string, int> host_and_port(const std::string& listen) {
+  const auto colon = listen.rfind(':');
+  std::string host = listen.substr(0, colon == std::string::npos ? 0 : colon);
+  const std::string port = colon == std::string::npos ? "" : listen.substr(colon + 1);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+  if (host.empty() || port.empty() || port.size() > 5 || port.find_first_not_of("0123456789") != std::string::npos ||
+      std::stoi(port) > 65535)
+    throw std::runtime_error("--http-listen " + listen + ": expected host:port");
+  return {host, std::stoi(port)};
+}
+
+const HttpRoute* find_route(const std::string& method, const std::string& path) {
+  for (const HttpRoute& route : http_routes())
+    if (route.path == path && (route.method == method || (method == "HEAD" && route.method == "GET"))) return &route;
+  return nullptr;
+}
+
+// NOT_FOUND for an unknown path, UNIMPLEMENTED (405) with the allowed methods for a known one.
+grpc::Status unmatched_status(const httplib::Request& request, std::string& allowed) {
+  for (const HttpRoute& route : http_routes())
+    if (route.path == request.path) allowed += (allowed.empty() ? "" : ", ") + std::string(route.method);
+  if (allowed.empty())
+    return {grpc::StatusCode::NOT_FOUND, "no route " + request.path + " (the API is described at /openapi.json)"};
+  return {grpc::StatusCode::UNIMPLEMENTED, request.method + " is not allowed on " + request.path + " (" + allowed + ")"};
+}
+
+}  // namespace
+
+HttpServer::HttpServer(const ServiceContext& service, const std::string& listen) : service_(service) {
+  const std::size_t threads = service.queue.workers() + service.queue.capacity() + kSpareThreads;
+  server_.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+  server_.set_keep_alive_timeout(kKeepAliveTimeoutS);
+  server_.set_keep_alive_max_count(100);
+  server_.set_read_timeout(kReadTimeoutS);
+  for (const HttpRoute& route : http_routes()) {
+    const std::string pattern = regex_escaped(route.path);
+    if (route.method == "GET")
+      server_.Get(pattern, [this, &route](const httplib::Request& request, httplib::Response& response) {
+        dispatch(route, request, response, nullptr);
+      });
+    else
+      server_.Post(pattern, [this, &route](const httplib::Request& request, httplib::Response& response,
+                                           const httplib::ContentReader& content) {
+        dispatch(route, request, response, &content);
+      });
+  }
+  // Registered last, so they see only what no route took.
+  const auto without_body = [this](const httplib::Request& request, httplib::Response& response) {
+    unmatched(request, response, nullptr);
+  };
+  const auto with_body = [this](const httplib::Request& request, httplib::Response& response,
+                                const httplib::ContentReader& content) { unmatched(request, response, &content); };
+  server_.Get(".*", without_body);
+  server_.Options(".*", without_body);
+  server_.Post(".*", with_body);
+  server_.Put(".*", with_body);
+  server_.Patch(".*", with_body);
+  server_.Delete(".*", with_body);
+  server_.set_expect_100_continue_handler(
+      [this](const httplib::Request& request, httplib::Response& response) { return expect_continue(request, response); });
+  server_.set_error_handler(httplib::Server::HandlerWithResponse(
+      [this](const httplib::Request& request, httplib::Response& response) { return protocol_error(request, response); }));
+
+  const auto [host, port] = host_and_port(listen);
+  port_ = port == 0 ? server_.bind_to_any_port(host) : (server_.bind_to_port(host, port) ? port : -1);
+  if (port_ <= 0) throw std::runtime_error("cannot listen on " + listen + " (HTTP)");
+}
+
+HttpServer::~HttpServer() { stop(); }
+
+void HttpServer::start() {
+  thread_ = std::thread([this] { server_.listen_after_bind(); });
+  // stop() right after start() must find a running server to stop.
+  while (!server_.is_running()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+}
+
+void HttpServer::stop() {
+  stopping_ = true;
+  server_.stop();
+  if (thread_.joinable()) thread_.join();  // listen_after_bind returns once its pool has finished every connection
+}
+
+void HttpServer::dispatch(const HttpRoute& route, const httplib::Request& request, httplib::Response& response,
+                          const httplib::ContentReader* content) {
+  HttpExchange exchange(service_, request, response, route_name(route), content, stopping_);
+  exchange.record.probe = route.probe;
+  try {
+    route.handle(service_, exchange);
+  } catch (...) {
+    exchange.fail(status_from_current_exception());
+  }
+  exchange.end();
+}
+
+void HttpServer::unmatched(const httplib::Request& request, httplib::Response& response,
+                           const httplib::ContentReader* content) {
+  HttpExchange exchange(service_, request, response, kUnmatchedRoute, content, stopping_);
+  std::string allowed;
+  exchange.fail(unmatched_status(request, allowed));
+  if (!allowed.empty()) response.set_header("Allow", allowed);
+  exchange.end();
+}
+
+int HttpServer::expect_continue(const httplib::Request& request, httplib::Response& response) {
+  const HttpRoute* route = find_route(request.method, request.path);
+  std::string allowed;
+  const grpc::Status status = !route                 ? unmatched_status(request, allowed)
+                              : route->check_headers ? route->check_headers(service_, request)
+                                                     : grpc::Status::OK;
+  if (status.ok()) return 100;
+  HttpExchange exchange(service_, request, response, route ? route_name(*route) : kUnmatchedRoute, nullptr, stopping_);
+  exchange.fail(status);
+  if (!allowed.empty()) response.set_header("Allow", allowed);
+  exchange.end_before_body();
+  return response.status;
+}
+
+httplib::Server::HandlerResponse HttpServer::protocol_error(const httplib::Request& request,
+                                                            httplib::Response& response) {
+  if (response.has_header("Content-Type")) return httplib::Server::HandlerResponse::Unhandled;  // a route's answer
+  const int status = response.status;
+  HttpExchange exchange(service_, request, response, kUnmatchedRoute, nullptr, stopping_);
+  const grpc::StatusCode code = status == 413   ? grpc::StatusCode::RESOURCE_EXHAUSTED
+                                : status >= 500 ? grpc::StatusCode::INTERNAL
+                                                : grpc::StatusCode::INVALID_ARGUMENT;
+  exchange.fail({code, "malformed HTTP request (HTTP status " + std::to_string(status) + ")"}, status);
+  exchange.end();
+  return httplib::Server::HandlerResponse::Handled;
+}
+
+}  // namespace k4reg::service

@@ -1,0 +1,54 @@
+// k4reg-server's HTTP/1.1 listener (cpp-httplib) for the routes of http_routes.h, in the same process and on
+// the same ServiceContext (queue, limits, metrics, access log) as the gRPC service.
+//
+// Threads: cpp-httplib serves each connection on one thread of a fixed pool, and a registration holds its
+// thread while its job waits and runs. The pool has a thread for every job the queue can admit (workers +
+// --queue-size) plus spares for probes, metrics and quick refusals; further connections wait for a thread.
+#pragma once
+
+#include "http_lib.h"
+
+#include <atomic>
+#include <string>
+#include <thread>
+
+#include "http_routes.h"
+#include "service_context.h"
+
+namespace k4reg::service {
+
+class HttpServer {
+ public:
+  // Binds `listen`: "host:port", port 0 = ephemeral, "[::]:8080" for IPv6. Throws std::runtime_error.
+  HttpServer(const ServiceContext& service, const std::string& listen);
+  ~HttpServer();  // stop()
+  HttpServer(const HttpServer&) = delete;
+  HttpServer& operator=(const HttpServer&) = delete;
+
+  int port() const { return port_; }
+  // Serves on a thread of its own; returns once the listener runs.
+  void start();
+  // Stops listening, interrupts request bodies still arriving (their connections close), and returns once
+  // every request being answered has its answer; call after the jobs have ended (JobQueue::wait_idle).
+  // Idempotent.
+  void stop();
+
+ private:
+  void dispatch(const HttpRoute& route, const httplib::Request& request, httplib::Response& response,
+                const httplib::ContentReader* content);
+  // Unknown paths (404) and other methods on known paths (405), with or without a body.
+  void unmatched(const httplib::Request& request, httplib::Response& response, const httplib::ContentReader* content);
+  // "Expect: 100-continue": refuses what the headers already tell (401, 404, 413, 503, ...) before the client
+  // sends the body.
+  int expect_continue(const httplib::Request& request, httplib::Response& response);
+  // Answers cpp-httplib produced itself (malformed request line or headers): the same JSON errors and log.
+  httplib::Server::HandlerResponse protocol_error(const httplib::Request& request, httplib::Response& response);
+
+  const ServiceContext& service_;
+  std::atomic<bool> stopping_{false};
+  httplib::Server server_;
+  int port_ = 0;
+  std::thread thread_;
+};
+
+}  // namespace k4reg::service
