@@ -122,6 +122,13 @@ def k8s_env(d):
     return env
 
 
+def k8s_scrape_path(d):
+    """The path the pod annotations tell Prometheus to scrape, or None."""
+    _, deployment = d.deployment()
+    annotations = deployment["spec"]["template"]["metadata"].get("annotations", {}) if deployment else {}
+    return annotations.get("prometheus.io/path", "/metrics") if annotations.get("prometheus.io/scrape") == "true" else None
+
+
 def settings(d, overrides):
     """Variable -> value the server ends up with: --help defaults, then the image's ENV, then `overrides`."""
     values = {o.env: o.default for o in d.server_options.values() if o.env}
@@ -389,6 +396,9 @@ def check_kubernetes(d, problems):
     values, ports = check_server_environment(d, problems, where, k8s_env(d))
     container_ports = {p.get("name"): p["containerPort"] for p in container.get("ports", [])}
     problems.expect(container_ports == ports, where, f"container ports {container_ports} but the server listens on {ports}")
+    if k8s_scrape_path(d):
+        scrape_port = pod["metadata"]["annotations"].get("prometheus.io/port")
+        problems.expect(scrape_port == str(ports.get("http")), where, f"prometheus.io/port {scrape_port} is not the HTTP port")
 
     for probe, name in (("livenessProbe", "kLivenessService"), ("readinessProbe", "kReadinessService")):
         grpc = container.get(probe, {}).get("grpc", {})

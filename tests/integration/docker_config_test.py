@@ -63,6 +63,7 @@ BREAKAGES = [
     ("k8s/deployment.yaml", 'K4REG_MEMORY_BUDGET_MB\n              value: "3072"', 'K4REG_MEMORY_BUDGET_MB\n              value: "4000"',
      "memory limit 4Gi < budget 4000"),
     ("k8s/deployment.yaml", "containerPort: 8080", "containerPort: 8081", "container ports"),
+    ("k8s/deployment.yaml", 'prometheus.io/port: "8080"', 'prometheus.io/port: "9090"', "prometheus.io/port 9090 is not the HTTP port"),
     ("k8s/deployment.yaml", "runAsNonRoot: true", "runAsNonRoot: false", "runAsNonRoot must be true"),
     ("k8s/deployment.yaml", "runAsUser: 10001", "runAsUser: 1000", "runAsUser differs"),
     ("k8s/deployment.yaml", "mountPath: /spool", "mountPath: /tmp", "needs a writable volume"),

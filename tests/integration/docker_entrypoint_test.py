@@ -5,8 +5,9 @@ and container paths mapped to host folders: the data root to tests/data/bunny, t
 to temporary folders. The one other change: listen ports become 0 (ephemeral, so tests can run in
 parallel); the host part stays, and the HEALTHCHECK's --server port follows the bound port.
 
-Checks the HEALTHCHECK command, a registration of the bunny pair, and the SIGTERM drain: a job running
-when the signal arrives completes within the drain grace, readiness turns NOT_SERVING, exit code 0.
+Checks the HEALTHCHECK command and HTTP /healthz and /readyz, a registration of the bunny pair, and the
+SIGTERM drain: a job running when the signal arrives completes within the drain grace, readiness turns
+NOT_SERVING (gRPC) and 503 (HTTP), exit code 0.
 
     docker_entrypoint_test.py --repo REPO --bin-dir BUILD/bin"""
 
@@ -21,6 +22,8 @@ import sys
 import tempfile
 import time
 import unittest
+import urllib.error
+import urllib.request
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docker"))
@@ -94,6 +97,7 @@ class ContainerRun:
         serving = wait_for(lambda: self.log("serving") or self.process.poll() is not None, 30, "the server to start")
         assert self.process.poll() is None, f"the server exited at start-up: {self.log_path.read_text()}"
         self.grpc_port = serving[0]["grpc_port"]
+        self.http_port = serving[0].get("http_port")
 
     def host_path(self, container_path):
         """Data roots are the bunny scans; any other container folder becomes a fresh folder under `work`."""
@@ -114,6 +118,15 @@ class ContainerRun:
             for previous, word in zip(command[:-1], command[1:])
         ]
         return subprocess.run(argv, capture_output=True, text=True, timeout=30)
+
+    def http_get(self, path):
+        """(status code, body) of GET http://127.0.0.1:<bound HTTP port><path>."""
+        direct = urllib.request.build_opener(urllib.request.ProxyHandler({}))  # never an http_proxy for loopback
+        try:
+            with direct.open(f"http://127.0.0.1:{self.http_port}{path}", timeout=10) as reply:
+                return reply.status, reply.read().decode()
+        except urllib.error.HTTPError as error:
+            return error.code, error.read().decode()
 
     def client(self, *arguments, **popen):
         """k4reg with --server pointing at this server."""
@@ -171,6 +184,10 @@ class EntrypointTest(unittest.TestCase):
         health = server.healthcheck()
         self.assertEqual(health.returncode, 0, health.stdout + health.stderr)
         self.assertIn("readiness: SERVING", health.stdout)
+        self.assertIsNotNone(server.http_port, "the image sets K4REG_HTTP_LISTEN; the server must serve HTTP")
+        status, body = server.http_get("/healthz")
+        self.assertEqual((status, json.loads(body)), (200, {"status": "SERVING"}))
+        self.assertEqual(server.http_get("/readyz")[0], 200)
 
         # A registration of files under the data root, as the compose load service sends them.
         client = server.client("register", *BUNNY, "--json")
@@ -189,6 +206,8 @@ class EntrypointTest(unittest.TestCase):
         health = server.healthcheck()
         self.assertEqual(health.returncode, 1, "the HEALTHCHECK must fail while draining")
         self.assertIn("readiness: NOT_SERVING", health.stdout)
+        self.assertEqual(server.http_get("/readyz")[0], 503)
+        self.assertEqual(server.http_get("/healthz")[0], 200)
         out, err = slow.communicate(timeout=120)
         self.assertEqual(slow.returncode, 0, err)
         self.assertIn("transform", json.loads(out))
@@ -204,6 +223,12 @@ class EntrypointTest(unittest.TestCase):
                 server = self.run_container(overrides)
                 health = server.healthcheck()
                 self.assertEqual(health.returncode, 0, health.stdout + health.stderr)
+                self.assertEqual(server.http_get("/healthz")[0], 200)
+                scrape = deployment_check.k8s_scrape_path(self.d) if name == "k8s" else None
+                if scrape:
+                    status, body = server.http_get(scrape)
+                    self.assertEqual(status, 200, f"Prometheus would scrape {scrape}")
+                    self.assertIn("k4reg_build_info", body)
                 # The start-up log line names each setting after its flag (--max-connection-age-s: max_connection_age_s).
                 config = server.log("starting")[0]["config"]
                 for variable, value in overrides.items():
