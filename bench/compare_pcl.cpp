@@ -9,7 +9,6 @@
 // The orchestrator simulates (and caches) the scans, then for every pair runs the keypoint job once and
 // the methods interleaved trial by trial, each run in a fresh worker process (see compare_job.h).
 #include <CLI/CLI.hpp>
-#include <Eigen/LU>
 
 #include <algorithm>
 #include <chrono>
@@ -27,11 +26,10 @@
 #include "child_process.h"
 #include "compare_job.h"
 #include "compare_report.h"
-#include "k4reg/cloud_io.h"
 #include "k4reg/gt_pairs.h"
-#include "k4reg/matrix_file.h"
-#include "sim/scanner.h"
-#include "sim/scene.h"
+#include "markdown_block.h"
+#include "simulated_scan_cache.h"
+#include "table_format.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -139,33 +137,6 @@ std::vector<std::string> methods_for(const Suite& suite, const Case& c, int tria
   return methods;
 }
 
-// ---- simulated scans, cached as PLY files with their ground truth ----
-
-struct SimulatedFile {
-  std::string path;
-  Eigen::Matrix4d scan_to_scene;
-};
-
-SimulatedFile simulated_scan(const std::string& scene_name, int station, std::size_t points, const Options& o) {
-  const std::uint64_t seed = static_cast<std::uint64_t>(station) + 1;
-  const std::string stem = o.cache_dir + "/" + scene_name + "-station" + std::to_string(station) + "-" +
-                           std::to_string(points) + "-seed" + std::to_string(seed);
-  SimulatedFile file{stem + ".ply", Eigen::Matrix4d::Identity()};
-  if (!fs::exists(file.path) || !fs::exists(stem + ".gt.txt")) {
-    std::printf("simulating %s station %d, %zu points ...\n", scene_name.c_str(), station, points);
-    std::fflush(stdout);
-    fs::create_directories(o.cache_dir);
-    sim::ScanParams params;
-    params.points = points;
-    params.seed = seed;
-    const sim::SimulatedScan scan = sim::simulate_scan(sim::make_scene(scene_name), station, params);
-    write_cloud(file.path, scan.cloud);
-    write_matrix4(stem + ".gt.txt", scan.scan_to_scene);
-  }
-  file.scan_to_scene = read_matrix4(stem + ".gt.txt");
-  return file;
-}
-
 std::vector<std::pair<int, int>> station_pairs(const Suite& suite, bool quick) {
   if (suite.name == "lab") {
     if (quick) return {{0, 1}, {0, 2}, {2, 3}};
@@ -207,11 +178,11 @@ void add_simulated_cases(std::size_t index, const Suite& suite, const Options& o
       for (const auto& [a, b] : station_pairs(suite, o.quick)) {
         Case c{index, std::to_string(a) + "-" + std::to_string(b), points, base_job(suite, sigma, o)};
         if (!keep(c)) continue;
-        const SimulatedFile source = simulated_scan(suite.name, a, points, o);
-        const SimulatedFile target = simulated_scan(suite.name, b, points, o);
+        const CachedScan source = cached_simulated_scan(o.cache_dir, suite.name, a, points);
+        const CachedScan target = cached_simulated_scan(o.cache_dir, suite.name, b, points);
         c.job.source = source.path;
         c.job.target = target.path;
-        c.job.truth = target.scan_to_scene.inverse() * source.scan_to_scene;
+        c.job.truth = source_to_target_truth(source, target);
         cases.push_back(c);
       }
 }
@@ -340,13 +311,6 @@ void print_detector(const char* name, const DetectorStats& d) {
     std::printf(" %s %zu/%zu (repeatability %.0f %%, %.1f s)", name, d.source, d.target, 100 * d.repeatability, d.seconds);
   else
     std::printf(" %s ERROR %s", name, d.error.c_str());
-}
-
-std::string clock_text(double seconds) {
-  const int s = static_cast<int>(seconds);
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%d:%02d:%02d", s / 3600, s / 60 % 60, s % 60);
-  return buffer;
 }
 
 std::string now_text() {

@@ -6,40 +6,15 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <limits>
 #include <set>
 #include <sstream>
-#include <stdexcept>
+
+#include "paper_tables.h"
+#include "statistics.h"
+#include "table_format.h"
 
 namespace k4reg::bench {
 namespace {
-
-// ---- formatting ----
-
-std::string fmt(const char* format, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, format, value);
-  return buffer;
-}
-
-std::string size_label(std::size_t points) { return points == 0 ? "–" : fmt("%.1fM", points / 1e6); }
-
-std::string sigma_label(double sigma_m) { return sigma_m < 1.0 ? fmt("%g mm", sigma_m * 1000.0) : fmt("%g m", sigma_m); }
-
-std::string percent(double fraction) { return std::isnan(fraction) ? "–" : fmt("%.0f %%", 100.0 * fraction); }
-
-std::string number(double value, const char* format) { return std::isnan(value) ? "–" : fmt(format, value); }
-
-// Lengths in metres, with enough digits for the bunny's millimetres.
-std::string metres(double value) {
-  if (std::isnan(value)) return "–";
-  return value < 0.01 ? fmt("%.4f", value) : value < 1.0 ? fmt("%.3f", value) : fmt("%.2f", value);
-}
-
-std::string seconds(double value) {
-  if (std::isnan(value)) return "–";
-  return value < 10 ? fmt("%.2f", value) : value < 100 ? fmt("%.1f", value) : fmt("%.0f", value);
-}
 
 const char* method_label(const std::string& method) {
   if (method == kOursK4pcs) return "K-4PCS k4reg";
@@ -52,26 +27,6 @@ const char* method_label(const std::string& method) {
 }
 
 bool is_ours(const std::string& method) { return method == kOursK4pcs || method == kOursPlain || method == kOursMatch; }
-
-// ---- statistics ----
-
-constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
-
-double median(std::vector<double> v) {
-  if (v.empty()) return kNan;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-double minimum(const std::vector<double>& v) { return v.empty() ? kNan : *std::min_element(v.begin(), v.end()); }
-double maximum(const std::vector<double>& v) { return v.empty() ? kNan : *std::max_element(v.begin(), v.end()); }
-double mean(const std::vector<double>& v) {
-  if (v.empty()) return kNan;
-  double sum = 0;
-  for (double x : v) sum += x;
-  return sum / v.size();
-}
 
 // All runs of one method on one (suite, size, sigma): one line of the tables.
 struct Row {
@@ -201,32 +156,6 @@ std::size_t suite_index(const Report& report, const std::string& name) {
     if (report.suites[i].name == name) return i;
   return report.suites.size();
 }
-
-// ---- the paper's numbers (Theiler et al. 2014, real Z+F scans), for orientation only ----
-
-struct PaperCell {
-  double sigma_mm;
-  std::size_t points;
-  int kp, sr;
-};
-constexpr PaperCell kPaperTable2[] = {
-    {100, 700000, 1100, 91}, {100, 2500000, 1100, 95}, {100, 10000000, 1200, 95},
-    {50, 700000, 2800, 98},  {50, 2500000, 2800, 98},  {50, 10000000, 3200, 98},
-    {25, 700000, 5900, 98},  {25, 2500000, 6800, 97},  {25, 10000000, 8200, 100},
-};
-
-struct PaperComparison {
-  double sigma_mm;
-  const char* four_pcs;   // SR / RMSE / T of 4PCS
-  const char* k4pcs;      // SR / RMSE / T (/ KP) of K-4PCS
-};
-constexpr PaperComparison kPaperTable3[] = {{100, "4 % / 0.66 m / 18 s (900 mm grid)", "91 % / 0.15 m / 8 s"},
-                                            {50, "35 % / 0.46 m / 589 s (500 mm grid)", "98 % / 0.06 m / 41 s"},
-                                            {25, "62 % / 0.28 m / 9637 s (350 mm grid)", "98 % / 0.04 m / 102 s"}};
-constexpr PaperComparison kPaperTable4[] = {
-    {100, "10 % / 0.80 m / 652 s (1500 mm grid)", "57 % / 0.52 m / 182 s / KP 2900"},
-    {50, "30 % / 0.79 m / 9800 s (1000 mm grid)", "100 % / 0.40 m / 663 s / KP 6000"},
-    {25, "N.A. (> 72 h)", "83 % / 0.17 m / 2047 s / KP 10400"}};
 
 std::vector<double> sigmas_of(const Suite& suite) {
   std::vector<double> s = suite.sigmas_m;
@@ -597,21 +526,6 @@ std::string markdown(const Report& report, const std::string& results_dir_in_rep
         "arch (Theiler et al. 2014, Tables 2–4); our scenes are simulated look-alikes, so compare trends, not "
         "digits.\n";
   return md.str();
-}
-
-void replace_block(const std::string& file, const std::string& name, const std::string& content) {
-  const std::string begin = "<!-- " + name + ":begin -->", end = "<!-- " + name + ":end -->";
-  std::string text;
-  if (std::ifstream in(file); in) text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  const std::string block = begin + "\n" + content + (content.ends_with("\n") ? "" : "\n") + end;
-  const std::size_t b = text.find(begin), e = text.find(end);
-  if (b != std::string::npos && e != std::string::npos && e > b)
-    text.replace(b, e + end.size() - b, block);
-  else
-    text += (text.empty() || text.ends_with("\n") ? "" : "\n") + std::string("\n") + block + "\n";
-  std::ofstream out(file);
-  if (!out) throw std::runtime_error("cannot write " + file);
-  out << text;
 }
 
 }  // namespace k4reg::bench

@@ -93,8 +93,4 @@ void write_outputs(const Report& report, const std::string& dir);
 // The markdown block for RESULTS.md.
 std::string markdown(const Report& report, const std::string& results_dir_in_repo);
 
-// Replaces the text between "<!-- name:begin -->" and "<!-- name:end -->" in file (appending the block
-// when the markers are missing, creating the file when needed).
-void replace_block(const std::string& file, const std::string& name, const std::string& content);
-
 }  // namespace k4reg::bench

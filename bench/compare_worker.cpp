@@ -28,6 +28,7 @@
 #include "k4reg/surface_signal.h"
 #include "k4reg/voxel_grid.h"
 #include "pcl_methods.h"
+#include "truth_error.h"
 
 namespace k4reg::bench {
 
@@ -157,13 +158,8 @@ LoadedPair load_pair(const Job& job) {
   return pair;
 }
 
-// The paper's measures on (at most ~200 k evenly strided) source points.
 json errors(const PointCloud& source, const Eigen::Matrix4d& estimate, const Eigen::Matrix4d& truth) {
-  const std::size_t stride = std::max<std::size_t>(1, source.size() / 200000);
-  std::vector<Eigen::Vector3f> sample;
-  for (std::size_t i = 0; i < source.size(); i += stride) sample.push_back(source.points[i]);
-  const Eigen::Matrix4d shift = translation(source.origin_m);  // metrics take local points
-  const TransformError e = transform_error(sample, estimate * shift, truth * shift);
+  const TransformError e = file_frame_error(source, estimate, truth);
   return {{"mae_deg", e.mae_deg},
           {"mte_m", e.mte_m},
           {"rotation_deg", e.rotation_deg},
