@@ -15,14 +15,26 @@ namespace {
 
 struct AlignOptions {
   std::string source, target, out, gt_source, gt_target;
+  std::string source_scan, target_scan;  // multi-scan files: an index or an E57 scan name; "" = all scans
   bool json = false;
   double success_rmse_m = kIndoorSuccessRmse_m;
   RegistrationParams params;
 };
 
+// A number selects a scan by its 0-based index, anything else by its name.
+ReadOptions scan_selection(const std::string& scan) {
+  ReadOptions options;
+  if (scan.empty()) return options;
+  if (scan.find_first_not_of("0123456789") == std::string::npos && scan.size() < 10)
+    options.scan_index = std::stoul(scan);
+  else
+    options.scan_name = scan;
+  return options;
+}
+
 void run_align(const AlignOptions& o) {
-  const PointCloud source = read_cloud(o.source);
-  const PointCloud target = read_cloud(o.target);
+  const PointCloud source = read_cloud(o.source, scan_selection(o.source_scan));
+  const PointCloud target = read_cloud(o.target, scan_selection(o.target_scan));
   const RegistrationResult result = register_clouds(source, target, o.params);
   if (!o.out.empty()) write_matrix4(o.out, result.transform);
 
@@ -53,8 +65,11 @@ void run_align(const AlignOptions& o) {
 void add_align_command(CLI::App& app) {
   auto options = std::make_shared<AlignOptions>();
   CLI::App* align = app.add_subcommand("align", "register SOURCE onto TARGET locally (no server)");
-  align->add_option("SOURCE", options->source, "source scan (PLY, PCD, XYZ/TXT/PTS)")->required()->check(CLI::ExistingFile);
+  align->add_option("SOURCE", options->source, "source scan (PLY, PCD, XYZ/TXT/PTS, LAS, PTX, E57)")->required()->check(CLI::ExistingFile);
   align->add_option("TARGET", options->target, "target scan")->required()->check(CLI::ExistingFile);
+  align->add_option("--source-scan", options->source_scan,
+                    "multi-scan SOURCE (E57, PTX): the scan's 0-based index or E57 name (default: all scans merged)");
+  align->add_option("--target-scan", options->target_scan, "multi-scan TARGET: index or E57 name, as --source-scan");
   add_registration_flags(*align, options->params);
   align->add_flag("--json", options->json, "print the result as JSON");
   align->add_option("--out", options->out, "write the 4x4 source->target matrix to this file");

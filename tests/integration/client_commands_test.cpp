@@ -13,6 +13,8 @@
 #include <sstream>
 #include <thread>
 
+#include "k4reg/cloud_io.h"
+#include "k4reg/e57_io.h"
 #include "test_support.h"
 
 extern char** environ;
@@ -188,6 +190,22 @@ TEST_F(ClientCommands, DrainingServerIsNotReadyAndSaysWhy) {
   EXPECT_EQ(refused.err.find("cannot reach"), std::string::npos) << refused.err;
   context.TryCancel();
   call.finish();
+}
+
+TEST_F(ClientCommands, AlignPicksScansOfAMultiScanFileByNameOrIndex) {
+  // Both bunny scans in one E57 (as a project export holds its stations): the same result as the two files.
+  const TempDir dir;
+  const std::string project = (dir.path() / "project.e57").string();
+  auto scan = [](const char* name) { return E57Scan{name, read_cloud(bunny(std::string(name) + ".ply")), Eigen::Isometry3d::Identity(), {}}; };
+  write_e57(project, {scan("bun045"), scan("bun000")});
+  const CommandRun align =
+      k4reg(concat({"align", project, project, "--source-scan", "bun045", "--target-scan", "1", "--json"}, kBunnyFlags));
+  ASSERT_EQ(align.exit_code, 0) << align.err;
+  EXPECT_EQ(nlohmann::json::parse(align.out)["transform"], (*local_)["transform"]);
+
+  const CommandRun missing = k4reg(concat({"align", project, project, "--source-scan", "bun999"}, kBunnyFlags));
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("bun999"), std::string::npos) << missing.err;
 }
 
 TEST_F(ClientCommands, MissingLocalFileIsOneLineAndExitOne) {
