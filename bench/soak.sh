@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-600}
 build=${K4REG_BENCH_BUILD_DIR:-build}
 
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DK4REG_BUILD_BENCH=OFF > /dev/null
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release > /dev/null
 cmake --build "$build" -j"$(nproc)" --target service_soak_test k4reg-server
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT

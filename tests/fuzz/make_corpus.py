@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Writes the fuzz seed corpus (tests/fuzz/corpus/<target>/) from the real scans in tests/data, trimmed to a few
-dozen points, plus hand-made edge cases. Inputs that were once findings are kept next to them as regress_*. Deterministic; rerun after adding a format and commit the output.
-The LAS, PTX and E57 seeds come from their writers' test files once those formats exist (see README.md)."""
+dozen points, plus hand-made edge cases; the LAS, PTX and E57 seeds come from the project's own writers
+(write_scan_seeds.cpp, built in the fuzz build). Inputs that were once findings stay next to them as regress_*.
+Deterministic; rerun after changing a format and commit the output."""
 import math
 import os
 import struct
@@ -174,14 +175,18 @@ def text_seeds():
 
 
 def request_seeds(ply, text):
-    """Serialized k4reg.v1 messages (protoc --python_out into a temporary folder): path and inline requests, every
-    parameter set, out-of-range and non-finite parameters, unknown enum values, a stream header and a chunk."""
+    """k4reg.v1 messages (protoc --python_out into a temporary folder): path and inline requests, every parameter
+    set, out-of-range and non-finite parameters, unknown enum values, a stream header and a chunk. Returns the
+    binary seeds (gRPC) and the RegisterRequests as JSON with proto field names (HTTP)."""
     proto_dir = os.path.join(HERE, "..", "..", "proto")
     with tempfile.TemporaryDirectory() as out:
         subprocess.run(["protoc", "-I", proto_dir, "--python_out=" + out,
                         os.path.join(proto_dir, "k4reg", "v1", "registration.proto")], check=True)
         sys.path.insert(0, out)
         from k4reg.v1 import registration_pb2 as pb
+        from google.protobuf import json_format
+
+    json_seeds = {}
 
     def request(source, target, **params):
         r = pb.RegisterRequest(params=pb.RegistrationParams(**params))
@@ -190,6 +195,8 @@ def request_seeds(ply, text):
                 cloud.path = value
             else:
                 cloud.inline_cloud.file_name, cloud.inline_cloud.data = value
+        json_seeds["%02d.json" % len(json_seeds)] = json_format.MessageToJson(
+            r, preserving_proto_field_name=True).encode()
         return r.SerializeToString()
 
     every = dict(min_scale_m=0.004, overlap=0.9, octaves=3, scales_per_octave=4, min_contrast=0.02, signal=3,
@@ -216,7 +223,12 @@ def request_seeds(ply, text):
     chunk.chunk.role = 1
     chunk.chunk.data = text["plain.xyz"]
     seeds["stream_chunk.bin"] = chunk.SerializeToString()
-    return seeds
+    # JSON the mapping allows besides what the printer writes: camelCase names, numbers as strings, enum numbers.
+    json_seeds["variants.json"] = (b'{"source": {"path": "a.ply"}, "target": {"inlineCloud": {"data": "AAEC", '
+                                   b'"fileName": "b.xyz"}}, "params": {"minScaleM": "0.01", "seed": "18446744073709551615",'
+                                   b' "signal": 2, "method": "COARSE_METHOD_PLAIN_4PCS", "icp": true, "threads": 1e0}}')
+    json_seeds["unknown_field.json"] = b'{"params": {"min_scale": 0.01}}'
+    return seeds, json_seeds
 
 
 def write(target, seeds):
@@ -227,19 +239,44 @@ def write(target, seeds):
             f.write(data)
 
 
+def folder_seeds(target):
+    folder = os.path.join(CORPUS, target)
+    seeds = {}
+    for name in sorted(os.listdir(folder)):
+        with open(os.path.join(folder, name), "rb") as f:
+            seeds[name] = f.read()
+    return seeds
+
+
 def main():
+    if len(sys.argv) != 2:
+        print("usage: make_corpus.py <fuzz build>/bin/write_scan_seeds  (scripts/fuzz.sh builds it)", file=sys.stderr)
+        return 2
+    subprocess.run([sys.argv[1], CORPUS], check=True)  # LAS, PTX and E57 seeds from the project's writers
+    # fuzz_read_e57 inputs start with a byte, odd = the harness rewrites the page CRCs (e57_fuzzer.cpp): each written
+    # file becomes one seed of each kind.
+    e57_folder = os.path.join(CORPUS, "fuzz_read_e57")
+    e57 = {name: data for name, data in folder_seeds("fuzz_read_e57").items() if name.endswith(".e57") and name[1] != "_"}
+    for name in e57:
+        os.remove(os.path.join(e57_folder, name))
+    write("fuzz_read_e57", {"%d_%s" % (crc, name): bytes([crc]) + data for name, data in e57.items() for crc in (0, 1)})
     ply, pcd, text = ply_seeds(), pcd_seeds(), text_seeds()
     write("fuzz_read_ply", ply)
     write("fuzz_read_pcd", pcd)
     write("fuzz_read_xyz", text)
-    # read_cloud_bytes: the first byte picks the file name hint (cloud_bytes_fuzzer.cpp): 0 = .ply, 1 = .pcd,
-    # 2 = .xyz, 11 = no extension.
+    # read_cloud_bytes: the first byte picks the file name hint (kNames in cloud_bytes_fuzzer.cpp): 0 .ply,
+    # 1 .pcd, 2 .xyz, 3 .txt, 7 .las, 9 .ptx, 10 .e57, 11 no extension.
     mixed = {}
-    for hint, seeds in ((0, ply), (1, pcd), (2, text), (11, text)):
-        for name, data in seeds.items():
+    hints = ((0, "fuzz_read_ply"), (1, "fuzz_read_pcd"), (2, "fuzz_read_xyz"), (11, "fuzz_read_xyz"),
+             (7, "fuzz_read_las"), (9, "fuzz_read_ptx"), (3, "fuzz_read_ptx"), (10, "fuzz_read_e57"),
+             (11, "fuzz_read_e57"))
+    for hint, target in hints:
+        for name, data in (e57 if target == "fuzz_read_e57" else folder_seeds(target)).items():
             mixed["%02d_%s" % (hint, name)] = bytes([hint]) + data
     write("fuzz_read_cloud_bytes", mixed)
-    write("fuzz_grpc_request", request_seeds(ply, text))
+    grpc_seeds, json_seeds = request_seeds(ply, text)
+    write("fuzz_grpc_request", grpc_seeds)
+    write("fuzz_http_request", json_seeds)
     return 0
 
 
