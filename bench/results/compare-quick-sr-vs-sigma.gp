@@ -11,16 +11,16 @@ set xrange [20:120]
 set yrange [0:105]
 set xtics (25, 50, 100)
 $d0 << EOD
-50 66.6667 
+50 100 
 EOD
 $d1 << EOD
-50 66.6667 
+50 100 
 EOD
 $d2 << EOD
 50 33.3333 
 EOD
 $d3 << EOD
-50 44.4444 
+50 66.6667 
 EOD
 plot $d0 with linespoints lw 2 pt 5 ps 1.5 title 'K-4PCS k4reg 0.7M', \
      $d1 with linespoints lw 2 pt 7 ps 1.5 title 'K-4PCS k4reg 2.5M', \

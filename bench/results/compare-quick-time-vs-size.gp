@@ -10,12 +10,12 @@ set logscale xy
 set xrange [0.5:14]
 set xtics (0.7, 2.5, 10)
 $d0 << EOD
-0.7 5.19375 2.37491 6.78423 
-2.5 7.50273 6.22831 8.89262 
+0.7 3.49494 1.88372 5.20424 
+2.5 6.19236 4.34331 7.41767 
 EOD
 $d1 << EOD
-0.7 5.95802 4.66047 10.9234 
-2.5 9.93381 8.2348 18.5056 
+0.7 5.74181 4.5614 9.86584 
+2.5 8.15131 7.13569 12.1921 
 EOD
 plot $d0 with yerrorlines lw 2 pt 5 ps 1.5 title 'K-4PCS k4reg σ 50 mm', \
      $d1 with yerrorlines lw 2 pt 7 ps 1.5 title 'K-4PCS PCL σ 50 mm'
