@@ -12,6 +12,7 @@ PACKAGES=(
   python3 python3-grpcio python3-protobuf
   libpugixml-dev prometheus
   gnuplot-nox yamllint python3-yaml docker-compose curl
+  clang libclang-rt-14-dev llvm  # sanitizer and fuzz builds; llvm has llvm-symbolizer for their reports
 )
 
 missing=()
