@@ -28,7 +28,8 @@ if ! grep -q '<!-- soak:begin -->' "$markdown"; then
 `bench/soak.sh SECONDS` runs `tests/integration/service_soak_test.cpp` for longer than CI does (CI: 20 s). Each
 line: one run; counts are `kind:grpc status code` (0 OK, 1 CANCELLED, 3 INVALID_ARGUMENT, 4 DEADLINE_EXCEEDED,
 5 NOT_FOUND, 7 PERMISSION_DENIED, 8 RESOURCE_EXHAUSTED, 15 DATA_LOSS). RSS and threads are the server's, from
-/proc/<pid>/status: baseline after a warm-up, peak during the soak, after it.
+/proc/<pid>/status: baseline after a warm-up, peak during the soak, after it; threads above the baseline are gRPC's
+executor threads, which grow on demand up to 2 x cores and stay (the test allows only those).
 
 <!-- soak:begin -->
 <!-- soak:end -->
