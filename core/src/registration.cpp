@@ -55,7 +55,8 @@ void validate(const RegistrationParams& p) {
   if (p.hypotheses_kept < 1 || p.hypotheses_kept > 100) bad("hypotheses_kept must be in [1, 100]");
   if (p.icp_max_iterations < 0 || p.icp_max_iterations > 1000) bad("icp_max_iterations must be in [0, 1000]");
   if (p.threads < 0 || p.threads > 1024) bad("threads must be in [0, 1024]");
-  if (!(p.time_budget_s >= 0.0) || !std::isfinite(p.time_budget_s)) bad("time_budget_s must be >= 0");
+  // The budget becomes a deadline in 64-bit nanoseconds: 1e9 s (32 years) keeps that conversion in range.
+  if (!(p.time_budget_s >= 0.0 && p.time_budget_s <= 1e9)) bad("time_budget_s must be in [0, 1e9] s");
   if (!(p.plain_voxel_m >= 0.0 && p.plain_voxel_m <= 100.0)) bad("plain_voxel_m must be in [0, 100] m");
 }
 

@@ -4,6 +4,7 @@
 // touch the real filesystem (PathPolicy is covered by the integration tests).
 #pragma once
 
+#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -32,6 +33,10 @@ inline void check_params(const v1::RegistrationParams& message) {
   if (!std::isfinite(params.min_scale_m) || !std::isfinite(params.overlap) || !std::isfinite(params.min_contrast) ||
       !std::isfinite(params.plain_voxel_m) || !std::isfinite(params.time_budget_s))
     finding("accepted a non-finite parameter");
+  // register_clouds turns the budget into a steady_clock deadline (64-bit nanoseconds): a larger value would
+  // overflow in the conversion, which is undefined behaviour.
+  if (std::chrono::duration<double>(params.time_budget_s) >= std::chrono::steady_clock::duration::max() / 2)
+    finding("accepted a time budget that overflows a steady_clock deadline");
 }
 
 inline void check_inline_cloud(const v1::InlineCloud& cloud, const char* role) {

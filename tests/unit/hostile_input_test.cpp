@@ -28,6 +28,7 @@
 #include "k4reg/error.h"
 #include "k4reg/las_io.h"
 #include "k4reg/ptx_io.h"
+#include "k4reg/registration.h"
 #include "k4reg/voxel_grid.h"
 
 // ---- allocation probe ------------------------------------------------------------------------------------
@@ -483,6 +484,18 @@ TEST(HostileInput, UnknownContentWithoutAHint) {
       {"binary garbage", "upload", garbage(4096, 6), ErrorCode::kInvalidArgument, "cannot determine"},
       {"NUL bytes", "upload.bin", std::string(4096, '\0'), ErrorCode::kInvalidArgument, "cannot determine"},
   });
+}
+
+TEST(HostileInput, ATimeBudgetThatOverflowsADeadlineIsRefused) {
+  // 1e300 s as steady_clock nanoseconds is out of range of int64 (undefined behaviour; in practice a deadline in the
+  // past): refused by validate(), which both APIs and the command line apply.
+  RegistrationParams params;
+  for (double budget : {1e300, 1e10, std::numeric_limits<double>::infinity()}) {
+    params.time_budget_s = budget;
+    EXPECT_THROW(validate(params), Error) << budget;
+  }
+  params.time_budget_s = 1e9;
+  EXPECT_NO_THROW(validate(params));
 }
 
 TEST(HostileInput, FarOutlierIsRefusedByTheVoxelGridNotWrapped) {

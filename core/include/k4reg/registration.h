@@ -57,7 +57,7 @@ struct RegistrationParams {
 
   std::uint64_t seed = 42;
   int threads = 0;             // 0 = all cores
-  double time_budget_s = 0.0;  // 0 = unlimited; otherwise kDeadlineExceeded after this long
+  double time_budget_s = 0.0;  // 0 = unlimited; otherwise kDeadlineExceeded after this long (at most 1e9)
 };
 
 struct Hypothesis {
