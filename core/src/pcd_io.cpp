@@ -498,16 +498,6 @@ PointCloud read_ascii(std::string_view data, const PcdHeader& header, const PcdL
   return io_detail::finish_cloud(std::move(points), std::move(intensity), name);
 }
 
-std::uint32_t load_u32le(const char* p) {
-  unsigned char b[4];
-  std::memcpy(b, p, 4);
-  return std::uint32_t{b[0]} | (std::uint32_t{b[1]} << 8) | (std::uint32_t{b[2]} << 16) | (std::uint32_t{b[3]} << 24);
-}
-
-void append_u32le(std::string& out, std::uint32_t v) {
-  for (int k = 0; k < 4; ++k) out.push_back(static_cast<char>((v >> (8 * k)) & 0xff));
-}
-
 }  // namespace
 
 PointCloud read_pcd_bytes(std::string_view data, const std::string& name, const ReadOptions& options) {
@@ -532,8 +522,8 @@ PointCloud read_pcd_bytes(std::string_view data, const std::string& name, const 
   if (remaining < 8)
     fail_truncated(name, "binary_compressed data needs an 8-byte size prefix, only " + std::to_string(remaining) +
                              " bytes follow the header");
-  const std::uint64_t compressed = load_u32le(data.data() + pos);
-  const std::uint64_t uncompressed = load_u32le(data.data() + pos + 4);
+  const std::uint64_t compressed = io_detail::load_le<std::uint32_t>(data.data() + pos);
+  const std::uint64_t uncompressed = io_detail::load_le<std::uint32_t>(data.data() + pos + 4);
   if (compressed > remaining - 8)
     fail_truncated(name, "binary_compressed header says " + std::to_string(compressed) + " compressed bytes, only " +
                              std::to_string(remaining - 8) + " follow");
@@ -616,8 +606,8 @@ void write_pcd(const std::string& path, const PointCloud& cloud, PcdEncoding enc
     if (packed.size() > std::numeric_limits<std::uint32_t>::max())
       fail_io(ErrorCode::kInvalidArgument, path, "cannot write binary_compressed: compressed data over 4 GiB");
     std::string sizes;
-    append_u32le(sizes, static_cast<std::uint32_t>(packed.size()));
-    append_u32le(sizes, static_cast<std::uint32_t>(columns.size()));
+    io_detail::append_le(sizes, static_cast<std::uint32_t>(packed.size()));
+    io_detail::append_le(sizes, static_cast<std::uint32_t>(columns.size()));
     out.write(sizes);
     out.write(packed);
   }
