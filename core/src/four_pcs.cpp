@@ -17,7 +17,7 @@ namespace k4reg {
 namespace {
 
 constexpr int kBatch = 8;               // bases per parallel batch (fixed: determinism)
-constexpr int kPrescreenPoints = 40;   // cheap first look before a full verification
+constexpr int kPrescreenPoints[] = {40, 200};  // cheap looks before a full verification
 constexpr std::size_t kMaxSetsPerBase = 20000;
 constexpr double kInlierFactor = 3.0;   // inlier distance in units of delta
 
@@ -76,6 +76,16 @@ class Verifier {
   const FreeSpaceImage* free_space_;
   std::vector<Eigen::Vector3f> points_;
 };
+
+// Whether the score over each prescreen's first points, scaled to all points, reaches `needed`.
+bool passes_prescreens(const Verifier& verifier, const Eigen::Matrix4d& t, double needed) {
+  for (const int points : kPrescreenPoints) {
+    if (static_cast<std::size_t>(points) >= verifier.size()) return true;
+    const double threshold = needed * points / verifier.size();
+    if (verifier.score(t, points, threshold) < threshold) return false;
+  }
+  return true;
+}
 
 struct Candidate {
   double score = 0;
@@ -163,17 +173,14 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
       }
       Eigen::Matrix3Xd from(3, 4), to(3, 4);
       for (int k = 0; k < 4; ++k) from.col(k) = base.point[k].cast<double>();
-      const double prescreen_fraction = std::min(1.0, double(kPrescreenPoints) / verifier.size());
       for (std::size_t s = 0; s < sets.size(); ++s) {
         if ((s & 255) == 0) check(cancel);
         for (int k = 0; k < 4; ++k) to.col(k) = target[sets[s][k]].cast<double>();
         const Eigen::Matrix4d t = fit_rigid(from, to);
         if (fit_rms(t, from, to) > tolerance.fit_rms_m) continue;
         const double beat = std::max(out.floor(), global_best);
-        // Prescreen on the first points: a hypothesis far below the best so far is not worth a full look.
-        const std::size_t few = std::min<std::size_t>(kPrescreenPoints, verifier.size());
-        const double partial = verifier.score(t, few, 0.0);
-        if (partial / prescreen_fraction < 0.5 * beat) continue;
+        // Prescreens on the first points: a hypothesis far below the best so far is not worth a full look.
+        if (!passes_prescreens(verifier, t, 0.5 * beat)) continue;
         const double full = verifier.score(t, verifier.size(), std::max(out.floor(), 0.5 * global_best));
         if (full > out.floor() && full > 0)
           out.offer({full, t}, kDistinctAngle_deg, kDistinctShiftDeltas * params.delta_m);

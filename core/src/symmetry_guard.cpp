@@ -2,6 +2,8 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <cmath>
@@ -24,21 +26,33 @@ namespace {
 double cloud_score(const std::vector<Eigen::Vector3f>& source, const NeighborGrid& grid, float tau,
                    const Eigen::Matrix4d& t, const FreeSpaceImage* free_space) {
   const Eigen::Affine3f a = to_affine3f(t);
-  std::size_t consistent = 0, contradicted = 0, unseen = 0;
-  for (const Eigen::Vector3f& p : source) {
-    const Eigen::Vector3f q = a * p;
-    if (grid.any_within(q, tau)) {
-      ++consistent;
-      continue;
-    }
-    if (!free_space) continue;
-    switch (free_space->classify(q)) {
-      case FreeSpaceImage::Seen::kSurface: ++consistent; break;
-      case FreeSpaceImage::Seen::kEmpty: ++contradicted; break;
-      case FreeSpaceImage::Seen::kOccluded:
-      case FreeSpaceImage::Seen::kUnknown: ++unseen; break;
-    }
-  }
+  struct Counts {
+    std::size_t consistent = 0, contradicted = 0, unseen = 0;
+  };
+  // Integer counts: the same for any split over threads.
+  const Counts counts = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, source.size(), 4096), Counts{},
+      [&](const tbb::blocked_range<std::size_t>& range, Counts c) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          const Eigen::Vector3f q = a * source[i];
+          if (grid.any_within(q, tau)) {
+            ++c.consistent;
+            continue;
+          }
+          if (!free_space) continue;
+          switch (free_space->classify(q)) {
+            case FreeSpaceImage::Seen::kSurface: ++c.consistent; break;
+            case FreeSpaceImage::Seen::kEmpty: ++c.contradicted; break;
+            case FreeSpaceImage::Seen::kOccluded:
+            case FreeSpaceImage::Seen::kUnknown: ++c.unseen; break;
+          }
+        }
+        return c;
+      },
+      [](Counts x, const Counts& y) {
+        return Counts{x.consistent + y.consistent, x.contradicted + y.contradicted, x.unseen + y.unseen};
+      });
+  const std::size_t consistent = counts.consistent, contradicted = counts.contradicted, unseen = counts.unseen;
   // A floor of 5 % of the points keeps poses that put nearly everything out of sight from scoring high.
   const double evidence = std::max(static_cast<double>(source.size() - unseen), 0.05 * source.size());
   return (static_cast<double>(consistent) - static_cast<double>(contradicted)) / std::max(1.0, evidence);
@@ -80,12 +94,28 @@ std::vector<Eigen::Matrix4d> principal_half_turns(const std::vector<Eigen::Vecto
   return turns;
 }
 
+// Every k-th point of each stage, at most max_points: settling a pose needs thousands of well-spread
+// correspondences, not the tens of thousands of the scored stage (ICP's cost is linear in them).
+IcpPyramid thinned(const IcpPyramid& pyramid, std::size_t max_points) {
+  IcpPyramid thin;
+  thin.stages.resize(pyramid.stages.size());
+  for (std::size_t s = 0; s < pyramid.stages.size(); ++s) {
+    const auto& points = pyramid.stages[s].points;
+    const std::size_t step = (points.size() + max_points - 1) / max_points;
+    thin.stages[s].voxel_m = pyramid.stages[s].voxel_m;
+    for (std::size_t i = 0; i < points.size(); i += std::max<std::size_t>(step, 1)) thin.stages[s].points.push_back(points[i]);
+  }
+  return thin;
+}
+
 }  // namespace
 
 SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& target,
                                     std::vector<Hypothesis> hypotheses, const FreeSpaceImage* free_space,
                                     const CancellationToken* cancel) {
   constexpr int kStages = 2, kIterations = 6;  // settle, don't polish: the final ICP does that
+  constexpr std::size_t kSettlePoints = 4000;
+  const IcpPyramid settling_source = thinned(source, kSettlePoints);
   const auto& scored = source.stages.at(kStages - 1);
   const auto& reference = target.stages.at(kStages - 1);
   const double voxel_m = reference.voxel_m;
@@ -95,7 +125,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   quick.stages = kStages;
   quick.max_iterations = kIterations;
   auto settle = [&](Hypothesis& h) {
-    h.transform = refine_icp(source, target, h.transform, quick, cancel).transform;
+    h.transform = refine_icp(settling_source, target, h.transform, quick, cancel).transform;
     h.cloud_score = cloud_score(scored.points, grid, tau, h.transform, free_space);
   };
   auto by_score = [](const Hypothesis& a, const Hypothesis& b) { return a.cloud_score > b.cloud_score; };

@@ -11,8 +11,6 @@
 namespace k4reg {
 namespace {
 
-constexpr int kAxisBits = 21;
-constexpr int kAxisLimit = 1 << (kAxisBits - 1);  // |index| < 2^20 per axis
 // Fixed chunking (not per thread) keeps the floating-point summation order, and so the output,
 // independent of the number of threads.
 constexpr std::size_t kChunkPoints = 1 << 18;
@@ -30,23 +28,6 @@ struct Chunk {
 
 }  // namespace
 
-std::uint64_t pack_voxel_key(const Eigen::Vector3i& index) {
-  const std::uint64_t mask = (1ULL << kAxisBits) - 1;
-  return (static_cast<std::uint64_t>(index.x() + kAxisLimit) & mask) |
-         ((static_cast<std::uint64_t>(index.y() + kAxisLimit) & mask) << kAxisBits) |
-         ((static_cast<std::uint64_t>(index.z() + kAxisLimit) & mask) << (2 * kAxisBits));
-}
-
-Eigen::Vector3i voxel_index(const Eigen::Vector3f& p, float inv_voxel) {
-  // Saturated before the conversion (an out-of-range float -> int conversion is undefined and wraps in practice):
-  // far points get indices beyond kAxisLimit, which voxel_grid() refuses. NaN saturates too.
-  constexpr float kSaturation = 1 << 30;
-  auto axis = [inv_voxel](float v) {
-    return static_cast<int>(std::fmax(-kSaturation, std::fmin(kSaturation, std::floor(v * inv_voxel))));
-  };
-  return Eigen::Vector3i(axis(p.x()), axis(p.y()), axis(p.z()));
-}
-
 VoxelizedCloud voxel_grid(const PointCloud& cloud, double voxel_m, const CancellationToken* cancel) {
   if (!(voxel_m > 0.0) || !std::isfinite(voxel_m))
     fail(ErrorCode::kInvalidArgument, "voxel size must be positive, got " + std::to_string(voxel_m));
@@ -63,7 +44,7 @@ VoxelizedCloud voxel_grid(const PointCloud& cloud, double voxel_m, const Cancell
     VoxelKeyMap map((end - begin) / 4);
     for (std::size_t i = begin; i < end; ++i) {
       const Eigen::Vector3i index = voxel_index(cloud.points[i], inv_voxel);
-      if ((index.array().abs() >= kAxisLimit).any())
+      if ((index.array().abs() >= kVoxelAxisLimit).any())
         fail(ErrorCode::kInvalidArgument, "cloud extent too large for a " + std::to_string(voxel_m) +
                                               " m voxel grid (more than 2^21 voxels along an axis)");
       const std::uint64_t key = pack_voxel_key(index);
