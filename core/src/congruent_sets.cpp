@@ -4,8 +4,11 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <string>
 
+#include "k4reg/error.h"
 #include "k4reg/neighbor_grid.h"
 
 namespace k4reg {
@@ -88,14 +91,21 @@ bool select_base(const std::vector<Eigen::Vector3f>& points, double min_width_m,
   return false;
 }
 
-PairIndex::PairIndex(const std::vector<Eigen::Vector3f>& points, double min_m, double max_m) {
+PairIndex::PairIndex(const std::vector<Eigen::Vector3f>& points, double min_m, double max_m,
+                     const CancellationToken* cancel, std::size_t max_pairs) {
   const std::size_t n = points.size();
   std::vector<std::vector<Pair>> rows(n);
+  std::atomic<std::size_t> collected{0};
   tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+    check(cancel);
     for (std::size_t j = i + 1; j < n; ++j) {
       const float d = (points[i] - points[j]).norm();
       if (in_range(d, min_m, max_m)) rows[i].push_back({d, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j)});
     }
+    if (collected += rows[i].size(); collected > max_pairs)
+      fail(ErrorCode::kResourceExhausted,
+           "4PCS: more than " + std::to_string(max_pairs) + " target point pairs among " + std::to_string(n) +
+               " points; use a larger min_scale_m (or plain_voxel_m for plain 4PCS)");
   });
   std::size_t total = 0;
   for (const auto& row : rows) total += row.size();
@@ -119,7 +129,8 @@ std::pair<const PairIndex::Pair*, const PairIndex::Pair*> PairIndex::with_length
 }
 
 void find_congruent_sets(const Base& base, const std::vector<Eigen::Vector3f>& target, const PairIndex& pairs,
-                         const CongruenceTolerances& tolerance, std::vector<Quadrilateral>& out) {
+                         const CongruenceTolerances& tolerance, std::size_t max_sets, std::vector<Quadrilateral>& out,
+                         const CancellationToken* cancel) {
   const auto [first1, last1] = pairs.with_length(base.length1, tolerance.pair_m);
   const auto [first2, last2] = pairs.with_length(base.length2, tolerance.pair_m);
   if (first1 == last1 || first2 == last2) return;
@@ -128,6 +139,7 @@ void find_congruent_sets(const Base& base, const std::vector<Eigen::Vector3f>& t
   std::vector<Eigen::Vector3f> crossings;
   crossings.reserve(2 * (last1 - first1));
   for (const auto* p = first1; p != last1; ++p) {
+    if (((p - first1) & 4095) == 0) check(cancel);
     const Eigen::Vector3f &qi = target[p->i], &qj = target[p->j];
     crossings.push_back(qi + base.r1 * (qj - qi));
     crossings.push_back(qj + base.r1 * (qi - qj));
@@ -141,7 +153,9 @@ void find_congruent_sets(const Base& base, const std::vector<Eigen::Vector3f>& t
   const float coincidence = static_cast<float>(tolerance.coincidence_m);
   const PairIndex::Pair* const diagonal1 = first1;  // a lambda cannot capture a structured binding before clang 16
 
-  for (const auto* p = first2; p != last2; ++p) {
+  const std::size_t limit = out.size() + max_sets;
+  for (const auto* p = first2; p != last2 && out.size() < limit; ++p) {
+    if (((p - first2) & 4095) == 0) check(cancel);
     for (int direction = 0; direction < 2; ++direction) {
       const std::uint32_t k = direction ? p->j : p->i, l = direction ? p->i : p->j;
       const Eigen::Vector3f& qk = target[k];
@@ -155,7 +169,7 @@ void find_congruent_sets(const Base& base, const std::vector<Eigen::Vector3f>& t
         if (std::abs((qi - qk).norm() - edge[0]) > edge_tolerance || std::abs((qi - ql).norm() - edge[1]) > edge_tolerance ||
             std::abs((qj - qk).norm() - edge[2]) > edge_tolerance || std::abs((qj - ql).norm() - edge[3]) > edge_tolerance)
           return;
-        out.push_back({i, j, k, l});
+        if (out.size() < limit) out.push_back({i, j, k, l});
       });
     }
   }

@@ -18,7 +18,8 @@ namespace {
 
 constexpr int kBatch = 8;               // bases per parallel batch (fixed: determinism)
 constexpr int kPrescreenPoints[] = {40, 200};  // cheap looks before a full verification
-constexpr std::size_t kMaxSetsPerBase = 20000;
+constexpr std::size_t kMaxSetsPerBase = 20000;     // verified per base (an even subsample)
+constexpr std::size_t kMaxSetsFound = 8 * kMaxSetsPerBase;  // collected per base: bounds memory and time
 constexpr double kInlierFactor = 3.0;   // inlier distance in units of delta
 
 // Robust extent of a cloud: the diagonal of the 2nd..98th percentile box, blind to a few far outliers.
@@ -145,7 +146,7 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
   // that the rotation is poorly determined.
   const double max_width = std::max(params.overlap * robust_diameter(source), 10.0 * params.delta_m);
   const double min_width = std::max(0.1 * max_width, 4.0 * params.delta_m);
-  const PairIndex pairs(target, min_width - tolerance.pair_m, max_width + tolerance.pair_m);
+  const PairIndex pairs(target, min_width - tolerance.pair_m, max_width + tolerance.pair_m, cancel);
   const Verifier verifier(source, target, kInlierFactor * params.delta_m, params.verification_points, params.seed,
                          params.target_free_space);
   const int bases = params.max_bases > 0 ? params.max_bases : bases_for_overlap(params.overlap);
@@ -161,7 +162,7 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
       Base base;
       if (!select_base(source, min_width, max_width, tolerance.coplanarity_m, rng, base)) return;
       std::vector<Quadrilateral> sets;
-      find_congruent_sets(base, target, pairs, tolerance, sets);
+      find_congruent_sets(base, target, pairs, tolerance, kMaxSetsFound, sets, cancel);
       BaseOutcome& out = outcomes[b];
       out.sets = sets.size();
       // Dense, regular point sets (the plain-4PCS baseline on a grid) give combinatorially many sets;

@@ -10,6 +10,8 @@
 #include <random>
 #include <vector>
 
+#include "k4reg/cancellation.h"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -46,7 +48,11 @@ bool select_base(const std::vector<Eigen::Vector3f>& points, double min_width_m,
 // All pairs of target points with length in [min_m, max_m], sorted by length.
 class PairIndex {
  public:
-  PairIndex(const std::vector<Eigen::Vector3f>& points, double min_m, double max_m);
+  // Throws kResourceExhausted beyond max_pairs pairs (12 bytes each: 360 MB by default) rather than
+  // exhaust memory. Cost: O(n^2) distances, in parallel; checks cancel per point.
+  static constexpr std::size_t kMaxPairs = 30'000'000;
+  PairIndex(const std::vector<Eigen::Vector3f>& points, double min_m, double max_m,
+            const CancellationToken* cancel = nullptr, std::size_t max_pairs = kMaxPairs);
   struct Pair {
     float length;
     std::uint32_t i, j;
@@ -62,8 +68,11 @@ class PairIndex {
 // Correspondence target[match[k]] <-> base.point[k].
 using Quadrilateral = std::array<std::uint32_t, 4>;
 
-// Appends the target 4-point sets congruent to base (both diagonal directions tried).
+// Appends the target 4-point sets congruent to base (both diagonal directions tried), at most max_sets:
+// dense regular point sets (plain 4PCS on a grid) match combinatorially many, and the caller only
+// verifies a bounded subsample anyway.
 void find_congruent_sets(const Base& base, const std::vector<Eigen::Vector3f>& target, const PairIndex& pairs,
-                         const CongruenceTolerances& tolerance, std::vector<Quadrilateral>& out);
+                         const CongruenceTolerances& tolerance, std::size_t max_sets, std::vector<Quadrilateral>& out,
+                         const CancellationToken* cancel = nullptr);
 
 }  // namespace k4reg
