@@ -7,6 +7,7 @@
 #include <random>
 
 #include "k4reg/error.h"
+#include "error_code_of.h"
 
 namespace k4reg {
 namespace {
@@ -24,16 +25,6 @@ std::vector<Eigen::Vector3f> regular_grid(int side, float spacing) {
   for (int y = 0; y < side; ++y)
     for (int x = 0; x < side; ++x) points.emplace_back(spacing * x, spacing * y, 0.0f);
   return points;
-}
-
-ErrorCode code_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.code();
-  }
-  ADD_FAILURE() << "expected a k4reg::Error";
-  return ErrorCode::kInternal;
 }
 
 TEST(PairIndex, ReturnsExactlyThePairsOfAGivenLength) {
@@ -54,7 +45,7 @@ TEST(PairIndex, ReturnsExactlyThePairsOfAGivenLength) {
 
 TEST(PairIndex, RefusesMorePairsThanItsBudget) {
   const auto points = random_points(600, 2);  // about 60 000 pairs within the band
-  EXPECT_EQ(code_of([&] { PairIndex(points, 0.0, 100.0, nullptr, 10000); }), ErrorCode::kResourceExhausted);
+  EXPECT_EQ(test::error_code_of([&] { PairIndex(points, 0.0, 100.0, nullptr, 10000); }), ErrorCode::kResourceExhausted);
   EXPECT_NO_THROW(PairIndex(points, 0.0, 100.0, nullptr, 1000000));
 }
 
@@ -62,7 +53,7 @@ TEST(PairIndex, StopsWhenCancelled) {
   CancellationToken cancel;
   cancel.cancel();
   const auto points = random_points(100, 3);
-  EXPECT_EQ(code_of([&] { PairIndex(points, 0.0, 100.0, &cancel); }), ErrorCode::kCancelled);
+  EXPECT_EQ(test::error_code_of([&] { PairIndex(points, 0.0, 100.0, &cancel); }), ErrorCode::kCancelled);
 }
 
 // A base on the grid and its own points must be among the congruent sets; a regular grid matches
@@ -107,7 +98,8 @@ TEST(CongruentSets, StopsWhenCancelled) {
   CancellationToken cancel;
   cancel.cancel();
   std::vector<Quadrilateral> sets;
-  EXPECT_EQ(code_of([&] { find_congruent_sets(base, grid, pairs, CongruenceTolerances::from_delta(0.1), 1000, sets, &cancel); }),
+  const CongruenceTolerances tolerance = CongruenceTolerances::from_delta(0.1);
+  EXPECT_EQ(test::error_code_of([&] { find_congruent_sets(base, grid, pairs, tolerance, 1000, sets, &cancel); }),
             ErrorCode::kCancelled);
 }
 

@@ -14,6 +14,7 @@
 
 #include "k4reg/cloud_io.h"
 #include "k4reg/error.h"
+#include "error_code_of.h"
 #include "k4reg/gt_pairs.h"
 #include "k4reg/metrics.h"
 
@@ -30,16 +31,6 @@ GtPair bunny_pair(const std::string& source, const std::string& target) {
   throw std::runtime_error("no ground truth for " + source + " -> " + target);
 }
 
-
-ErrorCode error_code(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.code();
-  }
-  ADD_FAILURE() << "expected a k4reg::Error";
-  return ErrorCode::kInternal;
-}
 
 RegistrationParams bunny_params(double overlap) {
   RegistrationParams p;
@@ -153,7 +144,8 @@ TEST(Registration, CancellationStopsWithin100ms) {
   RegistrationParams params = bunny_params(0.9);
   params.max_bases = 200000;  // minutes of work
   CancellationToken token;
-  auto job = std::async(std::launch::async, [&] { return error_code([&] { register_clouds(source, target, params, &token); }); });
+  auto job = std::async(std::launch::async,
+                        [&] { return test::error_code_of([&] { register_clouds(source, target, params, &token); }); });
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   const auto cancelled_at = std::chrono::steady_clock::now();
   token.cancel();
@@ -168,7 +160,7 @@ TEST(Registration, TimeBudgetGivesDeadlineExceeded) {
   params.max_bases = 200000;
   params.time_budget_s = 0.3;
   const auto start = std::chrono::steady_clock::now();
-  EXPECT_EQ(error_code([&] { register_clouds(source, target, params); }), ErrorCode::kDeadlineExceeded);
+  EXPECT_EQ(test::error_code_of([&] { register_clouds(source, target, params); }), ErrorCode::kDeadlineExceeded);
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(400));
 }
 
@@ -192,29 +184,29 @@ PointCloud grid_cloud(int nx, int ny, int nz, float step) {
 TEST(Registration, ClearErrors) {
   const PointCloud bunny = read_cloud(kBunny + "bun000.ply");
   const RegistrationParams ok = bunny_params(0.9);
-  EXPECT_EQ(error_code([&] { register_clouds(PointCloud{}, bunny, ok); }), ErrorCode::kInvalidArgument);
-  EXPECT_EQ(error_code([&] { register_clouds(bunny, PointCloud{}, ok); }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(test::error_code_of([&] { register_clouds(PointCloud{}, bunny, ok); }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(test::error_code_of([&] { register_clouds(bunny, PointCloud{}, ok); }), ErrorCode::kInvalidArgument);
   for (double scale : {0.0, -1.0, 1e-6, 100.0, double(NAN)}) {
     RegistrationParams p = ok;
     p.min_scale_m = scale;
-    EXPECT_EQ(error_code([&] { register_clouds(bunny, bunny, p); }), ErrorCode::kInvalidArgument) << scale;
+    EXPECT_EQ(test::error_code_of([&] { register_clouds(bunny, bunny, p); }), ErrorCode::kInvalidArgument) << scale;
   }
   for (double overlap : {0.0, 1.5, -0.2, double(NAN)}) {
     RegistrationParams p = ok;
     p.overlap = overlap;
-    EXPECT_EQ(error_code([&] { register_clouds(bunny, bunny, p); }), ErrorCode::kInvalidArgument) << overlap;
+    EXPECT_EQ(test::error_code_of([&] { register_clouds(bunny, bunny, p); }), ErrorCode::kInvalidArgument) << overlap;
   }
   // Degenerate geometry: a plane and a line.
   const PointCloud plane = grid_cloud(100, 100, 1, 0.01f), line = grid_cloud(1000, 1, 1, 0.01f);
-  EXPECT_EQ(error_code([&] { register_clouds(plane, plane, bunny_params(0.9)); }), ErrorCode::kInvalidArgument);
-  EXPECT_EQ(error_code([&] { register_clouds(line, bunny, bunny_params(0.9)); }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(test::error_code_of([&] { register_clouds(plane, plane, bunny_params(0.9)); }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(test::error_code_of([&] { register_clouds(line, bunny, bunny_params(0.9)); }), ErrorCode::kInvalidArgument);
   // A featureless box: a few uniform voxels give no DoG extrema.
   const PointCloud box = grid_cloud(4, 4, 4, 0.01f);
-  EXPECT_EQ(error_code([&] { register_clouds(box, bunny, bunny_params(0.9)); }), ErrorCode::kFailedPrecondition);
+  EXPECT_EQ(test::error_code_of([&] { register_clouds(box, bunny, bunny_params(0.9)); }), ErrorCode::kFailedPrecondition);
   // Intensity requested for clouds without it.
   RegistrationParams intensity = ok;
   intensity.signal = KeypointSignal::kIntensity;
-  EXPECT_EQ(error_code([&] { register_clouds(bunny, bunny, intensity); }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(test::error_code_of([&] { register_clouds(bunny, bunny, intensity); }), ErrorCode::kInvalidArgument);
 }
 
 TEST(Registration, NoHypothesisIsFailedPrecondition) {
@@ -226,7 +218,7 @@ TEST(Registration, NoHypothesisIsFailedPrecondition) {
   for (int i = 0; i < 30000; ++i) noise.points.emplace_back(u(rng), u(rng), u(rng));
   RegistrationParams p = bunny_params(0.9);
   p.max_bases = 10;
-  const ErrorCode code = error_code([&] { register_clouds(bunny, noise, p); });
+  const ErrorCode code = test::error_code_of([&] { register_clouds(bunny, noise, p); });
   EXPECT_EQ(code, ErrorCode::kFailedPrecondition);
 }
 
