@@ -8,7 +8,7 @@
 # --quick: a representative subset (about 20 min on 2 cores; Table 2 is left out to stay within that).
 #   Without it: the full suites (hours).
 # --table2: only k4reg-bench-table2: with --quick its 0.7M, sigma = 50 mm row (all 15 pairs x 10 seeds, about
-#   15-25 min on 2 cores), without it the full grid of 3 sizes x 3 sigmas (hours).
+#   3 min on 2 cores), without it the full grid of 3 sizes x 3 sigmas (about an hour on 2 cores).
 # Not part of the test suite. Build directory: $K4REG_BENCH_BUILD_DIR (default build-bench).
 set -euo pipefail
 cd "$(dirname "$0")/.."

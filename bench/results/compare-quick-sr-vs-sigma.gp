@@ -17,10 +17,10 @@ $d1 << EOD
 50 100 
 EOD
 $d2 << EOD
-50 33.3333 
+50 66.6667 
 EOD
 $d3 << EOD
-50 66.6667 
+50 44.4444 
 EOD
 plot $d0 with linespoints lw 2 pt 5 ps 1.5 title 'K-4PCS k4reg 0.7M', \
      $d1 with linespoints lw 2 pt 7 ps 1.5 title 'K-4PCS k4reg 2.5M', \
