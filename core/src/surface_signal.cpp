@@ -46,15 +46,11 @@ SurfaceSignal make_surface_signal(const PointCloud& voxels, double voxel_m, Keyp
   if (intensity) {
     if (!voxels.has_intensity()) fail(ErrorCode::kInvalidArgument, "intensity signal requested but a cloud has no intensity");
     // Intensity is reflectance times an incidence and range falloff that differ between stations. In
-    // log space those smooth factors become additive and the DoG (a band-pass) cancels them. The
-    // receiver's noise is additive, though, and a plain log amplifies it without bound on dark returns
-    // (grazing ground at range): the offset of 0.3 x the range caps that gain. On the simulated arch it
-    // raised keypoint repeatability from ~1 % to 4-11 % of the overlap; the lab stays at 10-28 %.
-    constexpr float kLogOffset = 0.3f;
+    // log space those smooth factors become additive and the DoG (a band-pass) cancels them.
     std::vector<float> values(voxels.intensity.size());
     const auto [lo, hi] = std::minmax_element(voxels.intensity.begin(), voxels.intensity.end());
-    const float offset = std::max(1e-6f, kLogOffset * (*hi - *lo));
-    for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::log(std::max(voxels.intensity[i] - *lo, 0.0f) + offset);
+    const float floor = std::max(1e-6f, 1e-3f * (*hi - *lo));
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::log(std::max(voxels.intensity[i] - *lo, 0.0f) + floor);
     return {std::move(values), "intensity"};
   }
   // Three voxels: enough neighbours (~28 on a plane) for a stable PCA, small enough to stay local.
