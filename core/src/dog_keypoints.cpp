@@ -167,9 +167,12 @@ DogKeypoints detect_dog_keypoints(const std::vector<Eigen::Vector3f>& points, co
   if (params.octaves < 1 || params.scales_per_octave < 1 || params.scales_per_octave + 3 > kMaxLevels)
     fail(ErrorCode::kInvalidArgument, "DoG: octaves must be at least 1 and scales_per_octave in [1, " +
                                           std::to_string(kMaxLevels - 3) + "]");
-  const double contrast = params.min_contrast * robust_range(signal);
+  const double range = robust_range(signal);
+  const double contrast = params.min_contrast * range;
 
   DogKeypoints out;
+  // A flat signal (e.g. a constant intensity field) has no extrema; float rounding would invent some.
+  if (!(range > 0.0)) return out;
   PointCloud octave;
   octave.points = points;
   octave.intensity = signal;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include "k4reg/dog_keypoints.h"
@@ -32,7 +33,14 @@ class StageTimer {
     if (progress_) progress_(stage, 0.0);
     const auto start = Clock::now();
     auto value = f();
-    result_.timings.push_back({stage, std::chrono::duration<double>(Clock::now() - start).count()});
+    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    // A stage run twice (the geometric fallback) reports its total.
+    auto same = std::find_if(result_.timings.begin(), result_.timings.end(),
+                             [&](const StageTiming& t) { return t.stage == stage; });
+    if (same != result_.timings.end())
+      same->seconds += seconds;
+    else
+      result_.timings.push_back({stage, seconds});
     if (progress_) progress_(stage, 1.0);
     return value;
   }
@@ -85,13 +93,27 @@ void check_geometry(const std::vector<Eigen::Vector3f>& points, double scale_m, 
 // The scanner sits at the file frame's origin, i.e. at -origin_m in the cloud's local frame.
 Eigen::Vector3f scanner_position(const PointCloud& cloud) { return (-cloud.origin_m).cast<float>(); }
 
+// Whether p lies inside the bounding box of the points.
+bool inside_bounds(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& p) {
+  Eigen::Vector3f low = Eigen::Vector3f::Constant(std::numeric_limits<float>::max()), high = -low;
+  for (const Eigen::Vector3f& q : points) {
+    low = low.cwiseMin(q);
+    high = high.cwiseMax(q);
+  }
+  return (p.array() >= low.array()).all() && (p.array() <= high.array()).all();
+}
+
 bool use_free_space(FreeSpaceCheck check, const VoxelizedCloud& source, const VoxelizedCloud& target) {
   if (check != FreeSpaceCheck::kAuto) return check == FreeSpaceCheck::kOn;
-  // Terrestrial scans surround their scanner at metres; object scans (whose origin may sit inside the
-  // object) have no meaningful free space around the frame origin.
+  // A terrestrial scan in its scanner's frame surrounds the origin at metres. Object scans (whose origin
+  // may sit inside the object) and georeferenced exports (whose origin is a map datum kilometres away)
+  // say nothing about where the scanner stood.
   constexpr double kMinScannerRange_m = 1.0;
-  return FreeSpaceImage::median_range_m(source.cloud.points, scanner_position(source.cloud)) >= kMinScannerRange_m &&
-         FreeSpaceImage::median_range_m(target.cloud.points, scanner_position(target.cloud)) >= kMinScannerRange_m;
+  auto scanner_known = [&](const PointCloud& cloud) {
+    return inside_bounds(cloud.points, scanner_position(cloud)) &&
+           FreeSpaceImage::median_range_m(cloud.points, scanner_position(cloud)) >= kMinScannerRange_m;
+  };
+  return scanner_known(source.cloud) && scanner_known(target.cloud);
 }
 
 // The voxel spacing at which a cloud keeps about `points` voxels (the paper's plain-4PCS baseline).
@@ -100,6 +122,15 @@ double spacing_for_count(const PointCloud& voxels, double start_m, std::size_t p
   for (int step = 0; step < 40 && voxel_grid(voxels, spacing).cloud.size() > points; ++step) spacing *= 1.25;
   return spacing;
 }
+
+// The outcome of steps 2-4 for one keypoint signal.
+struct CoarseAlignment {
+  std::string signal;
+  std::size_t source_keypoints = 0, target_keypoints = 0;
+  int bases_tried = 0;
+  SymmetryGuardResult guarded;
+  const Hypothesis& best() const { return guarded.hypotheses.front(); }
+};
 
 // Source -> target in the files' frames from the transform between the local (origin-shifted) frames.
 Eigen::Matrix4d to_file_frames(const Eigen::Matrix4d& local, const Eigen::Vector3d& source_origin,
@@ -130,76 +161,112 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
   check_geometry(source_voxels.cloud.points, sigma, "source");
   check_geometry(target_voxels.cloud.points, sigma, "target");
 
-  // 2. The point sets 4PCS runs on: DoG keypoints (K-4PCS) or a coarser voxel grid (plain 4PCS).
-  std::vector<Eigen::Vector3f> source_set, target_set;
-  // Keypoint precision: repeated keypoints of two scans lie within about 2 sigma of each other
-  // (measured on the simulated lab and the bunny), so every 4PCS tolerance derives from 2 sigma.
-  double delta = 2.0 * sigma;
-  if (params.method == CoarseMethod::kKeypoint4pcs) {
-    timer.run("keypoints", [&] {
-      const bool intensity = source.has_intensity() && target.has_intensity();
-      DogParams dog{sigma, params.octaves, params.scales_per_octave, params.min_contrast};
-      for (const auto* voxels : {&source_voxels, &target_voxels}) {
-        const SurfaceSignal signal = make_surface_signal(voxels->cloud, sigma, params.signal, intensity, cancel);
-        result.signal = signal.name;
-        auto& set = voxels == &source_voxels ? source_set : target_set;
-        set = detect_dog_keypoints(voxels->cloud.points, signal.values, dog, cancel).points;
-      }
-      return 0;
-    });
-    result.source_keypoints = source_set.size();
-    result.target_keypoints = target_set.size();
-    constexpr std::size_t kMinKeypoints = 8;
-    if (source_set.size() < kMinKeypoints || target_set.size() < kMinKeypoints)
-      fail(ErrorCode::kFailedPrecondition,
-           "too few keypoints (source " + std::to_string(source_set.size()) + ", target " +
-               std::to_string(target_set.size()) + "): try a smaller min_scale_m or check the clouds");
-  } else {
-    timer.run("plain_grid", [&] {
-      delta = params.plain_voxel_m > 0 ? params.plain_voxel_m : spacing_for_count(source_voxels.cloud, 4 * sigma, 2000);
-      source_set = voxel_grid(source_voxels.cloud, delta, cancel).cloud.points;
-      target_set = voxel_grid(target_voxels.cloud, delta, cancel).cloud.points;
-      return 0;
-    });
-    result.signal = "voxels";
-    result.source_keypoints = source_set.size();
-    result.target_keypoints = target_set.size();
-  }
-
-  // 3. 4PCS on the two point sets (paper Sec. 2.2), scored with the target's free space when known.
+  // The ICP pyramids serve the symmetry guard and the final refinement; built once, when first needed.
+  IcpParams icp_params;
+  icp_params.voxel_m = sigma;
+  icp_params.max_iterations = params.icp_max_iterations;
+  std::optional<std::pair<IcpPyramid, IcpPyramid>> pyramids;  // source, target
+  auto icp_pyramids = [&]() -> const std::pair<IcpPyramid, IcpPyramid>& {
+    if (!pyramids)
+      pyramids = timer.run("icp_setup", [&] {
+        return std::make_pair(make_icp_pyramid(source_voxels.cloud.points, icp_params, false, cancel),
+                              make_icp_pyramid(target_voxels.cloud.points, icp_params, true, cancel));
+      });
+    return *pyramids;
+  };
+  // The point precision every 4PCS tolerance derives from. Repeated keypoints of two scans lie within
+  // about 2 sigma of each other (measured on the simulated lab and the bunny); plain 4PCS works on a
+  // coarser grid, whose spacing it is.
+  const bool plain = params.method == CoarseMethod::kPlain4pcs;
+  const double delta = !plain ? 2.0 * sigma : timer.run("plain_grid", [&] {
+    return params.plain_voxel_m > 0 ? params.plain_voxel_m : spacing_for_count(source_voxels.cloud, 4 * sigma, 2000);
+  });
   result.free_space_used = use_free_space(params.free_space, source_voxels, target_voxels);
   std::optional<FreeSpaceImage> free_space;
   if (result.free_space_used)
     free_space.emplace(target.points, scanner_position(target), 3.0 * delta);  // raw points fill every cell
-  const FourPcsResult matched = timer.run("matching", [&] {
-    FourPcsParams four{delta, params.overlap, params.max_bases, params.hypotheses_kept, params.seed};
-    return match_4pcs(source_set, target_set, four, cancel, progress);
-  });
-  result.bases_tried = matched.bases_tried;
+  const ScanViews views{free_space ? &*free_space : nullptr, scanner_position(source), scanner_position(target)};
 
-  // 4. Symmetry guard: settle each distinct hypothesis with a short coarse ICP and re-score it on the
-  //    voxelised clouds, where the furniture that breaks a room's symmetry is visible.
-  IcpParams icp_params;
-  icp_params.voxel_m = sigma;
-  icp_params.max_iterations = params.icp_max_iterations;
-  const auto pyramids = timer.run("icp_setup", [&] {
-    return std::make_pair(make_icp_pyramid(source_voxels.cloud.points, icp_params, false, cancel),
-                          make_icp_pyramid(target_voxels.cloud.points, icp_params, true, cancel));
-  });
-  const auto &source_pyramid = pyramids.first, &target_pyramid = pyramids.second;
-  const SymmetryGuardResult guarded = timer.run("symmetry_guard", [&] {
-    return rank_hypotheses(source_pyramid, target_pyramid, matched.hypotheses, free_space ? &*free_space : nullptr,
-                           cancel);
-  });
-  result.hypotheses = guarded.hypotheses;
-  result.ambiguity_margin = guarded.ambiguity_margin;
+  // 2-4. Coarse alignment on one keypoint signal: the point sets, 4PCS, the symmetry guard.
+  auto coarse = [&](KeypointSignal signal) {
+    CoarseAlignment out;
+    // 2. The point sets 4PCS runs on: DoG keypoints (K-4PCS) or a coarser voxel grid (plain 4PCS).
+    std::vector<Eigen::Vector3f> source_set, target_set;
+    if (!plain) {
+      timer.run("keypoints", [&] {
+        const bool intensity = source.has_intensity() && target.has_intensity();
+        DogParams dog{sigma, params.octaves, params.scales_per_octave, params.min_contrast};
+        for (const auto* voxels : {&source_voxels, &target_voxels}) {
+          const SurfaceSignal surface = make_surface_signal(voxels->cloud, sigma, signal, intensity, cancel);
+          out.signal = surface.name;
+          auto& set = voxels == &source_voxels ? source_set : target_set;
+          set = detect_dog_keypoints(voxels->cloud.points, surface.values, dog, cancel).points;
+        }
+        return 0;
+      });
+      constexpr std::size_t kMinKeypoints = 8;
+      if (source_set.size() < kMinKeypoints || target_set.size() < kMinKeypoints)
+        fail(ErrorCode::kFailedPrecondition,
+             "too few keypoints (source " + std::to_string(source_set.size()) + ", target " +
+                 std::to_string(target_set.size()) + "): try a smaller min_scale_m or check the clouds");
+    } else {
+      timer.run("plain_grid", [&] {
+        source_set = voxel_grid(source_voxels.cloud, delta, cancel).cloud.points;
+        target_set = voxel_grid(target_voxels.cloud, delta, cancel).cloud.points;
+        return 0;
+      });
+      out.signal = "voxels";
+    }
+    out.source_keypoints = source_set.size();
+    out.target_keypoints = target_set.size();
+
+    // 3. 4PCS on the two point sets (paper Sec. 2.2), scored with the target's free space when known.
+    const FourPcsResult matched = timer.run("matching", [&] {
+      FourPcsParams four{delta, params.overlap, params.max_bases, params.hypotheses_kept, params.seed};
+      return match_4pcs(source_set, target_set, four, cancel, progress);
+    });
+    out.bases_tried = matched.bases_tried;
+
+    // 4. Symmetry guard: settle each distinct hypothesis with a short coarse ICP and re-score it on the
+    //    voxelised clouds, where the furniture that breaks a room's symmetry is visible.
+    const auto& icp = icp_pyramids();
+    out.guarded = timer.run("symmetry_guard", [&] {
+      return rank_hypotheses(icp.first, icp.second, matched.hypotheses, params.overlap, free_space ? &views : nullptr,
+                             cancel);
+    });
+    return out;
+  };
+
+  // Intensity first, as in the paper. Where its keypoints do not repeat between the scans (dark, noisy
+  // returns at grazing incidence outdoors, or a constant intensity field), the best pose it finds
+  // explains the clouds poorly or none is found at all; then the geometric signal gets its turn, and
+  // the pose the clouds support better stands (the cloud score does not depend on the signal).
+  constexpr double kWellSupported = 0.6;  // cloud score of true poses: lab ~0.95, outdoor ~0.85
+  std::optional<CoarseAlignment> chosen;
+  const bool may_fall_back =
+      !plain && params.signal == KeypointSignal::kAuto && source.has_intensity() && target.has_intensity();
+  try {
+    chosen = coarse(params.signal);
+  } catch (const Error& e) {
+    if (!may_fall_back || e.code() != ErrorCode::kFailedPrecondition) throw;
+  }
+  if (may_fall_back && (!chosen || chosen->best().cloud_score < kWellSupported)) {
+    CoarseAlignment geometric = coarse(KeypointSignal::kGeometric);
+    if (!chosen || geometric.best().cloud_score > chosen->best().cloud_score) chosen = std::move(geometric);
+  }
+  result.signal = chosen->signal;
+  result.source_keypoints = chosen->source_keypoints;
+  result.target_keypoints = chosen->target_keypoints;
+  result.bases_tried = chosen->bases_tried;
+  result.hypotheses = chosen->guarded.hypotheses;
+  result.ambiguity_margin = chosen->guarded.ambiguity_margin;
   const Hypothesis& best = result.hypotheses.front();
 
   // 5. ICP refinement on the voxelised clouds (or just the quality figures with --no-icp).
   const IcpResult refined = timer.run("icp", [&] {
     IcpParams final_params = icp_params;
     if (!params.icp) final_params.max_iterations = 0;  // quality figures only, at the finest stage
-    return refine_icp(source_pyramid, target_pyramid, best.transform, final_params, cancel);
+    return refine_icp(icp_pyramids().first, icp_pyramids().second, best.transform, final_params, cancel);
   });
   const Eigen::Matrix4d local = params.icp ? refined.transform : best.transform;
   result.icp_converged = params.icp && refined.converged;

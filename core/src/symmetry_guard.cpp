@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
@@ -16,16 +17,29 @@
 namespace k4reg {
 namespace {
 
-// Without free space: the share of source points with a target point within tau. With the target's
-// free space, a point is also consistent where it lies at the target scanner's first return in its
+// Whether two scanners looked at a surface (normal n, unoriented) from the same side: a pose that
+// matches a surface's front in one scan to its back in the other is wrong (turned upside down, the
+// ground near one scanner fits the ground near the other while everything above it goes underground).
+// Grazing views cannot tell the sides apart.
+bool seen_from_the_same_side(const Eigen::Vector3f& n, const Eigen::Vector3f& view_a, const Eigen::Vector3f& view_b) {
+  constexpr float kGrazingCos = 0.1f;
+  const float a = n.dot(view_a), b = n.dot(view_b);
+  return a * b >= 0.0f || std::abs(a) < kGrazingCos * view_a.norm() || std::abs(b) < kGrazingCos * view_b.norm();
+}
+
+// Without views: the share of source points with a target point within tau. With the target's free
+// space, a point is also consistent where it lies at the target scanner's first return in its
 // direction (sparse far surfaces have gaps wider than tau), contradicted where the target scanner saw
 // through it, and no evidence either way where that scanner could not see it (behind its first return,
-// or no return). Counting unseen points as misses favours the pose that maps one scanner's occlusion
-// shadows onto the other's — in a symmetric room, the flip. So the score is, of the points with
-// evidence, the share consistent less the share contradicted.
-double cloud_score(const std::vector<Eigen::Vector3f>& source, const NeighborGrid& grid, float tau,
-                   const Eigen::Matrix4d& t, const FreeSpaceImage* free_space) {
+// or no return) or where the two scanners saw its surface from opposite sides. Counting unseen points
+// as misses favours the pose that maps one scanner's occlusion shadows onto the other's — in a
+// symmetric room, the flip. So the score is, of the points with evidence, the share consistent less
+// the share contradicted.
+double cloud_score(const std::vector<Eigen::Vector3f>& source, const IcpPyramid::Stage& reference,
+                   const NeighborGrid& grid, float tau, const Eigen::Matrix4d& t, const ScanViews* views,
+                   double overlap) {
   const Eigen::Affine3f a = to_affine3f(t);
+  const Eigen::Vector3f source_scanner = views ? Eigen::Vector3f(a * views->source_scanner_m) : Eigen::Vector3f::Zero();
   struct Counts {
     std::size_t consistent = 0, contradicted = 0, unseen = 0;
   };
@@ -35,12 +49,15 @@ double cloud_score(const std::vector<Eigen::Vector3f>& source, const NeighborGri
       [&](const tbb::blocked_range<std::size_t>& range, Counts c) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
           const Eigen::Vector3f q = a * source[i];
-          if (grid.any_within(q, tau)) {
-            ++c.consistent;
+          const int k = grid.nearest_within(q, tau);
+          if (k >= 0) {
+            const bool same_side = !views || seen_from_the_same_side(reference.normals[k], q - source_scanner,
+                                                                      reference.points[k] - views->target_scanner_m);
+            ++(same_side ? c.consistent : c.unseen);
             continue;
           }
-          if (!free_space) continue;
-          switch (free_space->classify(q)) {
+          if (!views) continue;
+          switch (views->target_free_space->classify(q)) {
             case FreeSpaceImage::Seen::kSurface: ++c.consistent; break;
             case FreeSpaceImage::Seen::kEmpty: ++c.contradicted; break;
             case FreeSpaceImage::Seen::kOccluded:
@@ -53,8 +70,10 @@ double cloud_score(const std::vector<Eigen::Vector3f>& source, const NeighborGri
         return Counts{x.consistent + y.consistent, x.contradicted + y.contradicted, x.unseen + y.unseen};
       });
   const std::size_t consistent = counts.consistent, contradicted = counts.contradicted, unseen = counts.unseen;
-  // A floor of 5 % of the points keeps poses that put nearly everything out of sight from scoring high.
-  const double evidence = std::max(static_cast<double>(source.size() - unseen), 0.05 * source.size());
+  // A pose that puts most points out of the target scanner's sight (behind its walls, say) has little
+  // evidence, and the few points left can all agree: the share is taken of at least half the overlap
+  // the caller expects, so such a pose cannot outscore one that the target sees well.
+  const double evidence = std::max(static_cast<double>(source.size() - unseen), 0.5 * overlap * source.size());
   return (static_cast<double>(consistent) - static_cast<double>(contradicted)) / std::max(1.0, evidence);
 }
 
@@ -111,7 +130,7 @@ IcpPyramid thinned(const IcpPyramid& pyramid, std::size_t max_points) {
 }  // namespace
 
 SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& target,
-                                    std::vector<Hypothesis> hypotheses, const FreeSpaceImage* free_space,
+                                    std::vector<Hypothesis> hypotheses, double overlap, const ScanViews* views,
                                     const CancellationToken* cancel) {
   constexpr int kStages = 2, kIterations = 6;  // settle, don't polish: the final ICP does that
   constexpr std::size_t kSettlePoints = 4000;
@@ -124,30 +143,44 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   IcpParams quick;
   quick.stages = kStages;
   quick.max_iterations = kIterations;
+  // A hypothesis can be a metre or two off where it matters, beyond the guard's ICP stages: a 4PCS fit on
+  // keypoints a few metres apart tilts a wide outdoor scene by degrees, and a twin's estimated centre is
+  // rough. Two wider stages (2 and 4 times the pyramid's coarsest spacing, a few thousand points) reach
+  // further, but in a room they can also slide an exact pose along a wall; so each hypothesis settles
+  // from where it is and, if the wide stages take it elsewhere, from there too: the better score stands.
+  IcpParams wide;
+  wide.voxel_m = 2.0 * source.stages.front().voxel_m;
+  wide.stages = 2;
+  wide.max_iterations = 10;
+  const IcpPyramid wide_source = thinned(make_icp_pyramid(source.stages.front().points, wide, false, cancel), kSettlePoints);
+  const IcpPyramid wide_target = make_icp_pyramid(target.stages.front().points, wide, true, cancel);
   auto settle = [&](Hypothesis& h) {
-    h.transform = refine_icp(settling_source, target, h.transform, quick, cancel).transform;
-    h.cloud_score = cloud_score(scored.points, grid, tau, h.transform, free_space);
+    const Eigen::Matrix4d start = h.transform;
+    h.transform = refine_icp(settling_source, target, start, quick, cancel).transform;
+    h.cloud_score = cloud_score(scored.points, reference, grid, tau, h.transform, views, overlap);
+    const Eigen::Matrix4d pulled = refine_icp(wide_source, wide_target, start, wide, cancel).transform;
+    if (!distinct_transforms(pulled, h.transform, 1.0, target.stages.front().voxel_m)) return;  // same basin
+    const Eigen::Matrix4d settled = refine_icp(settling_source, target, pulled, quick, cancel).transform;
+    const double score = cloud_score(scored.points, reference, grid, tau, settled, views, overlap);
+    if (score > h.cloud_score) {
+      h.transform = settled;
+      h.cloud_score = score;
+    }
   };
   auto by_score = [](const Hypothesis& a, const Hypothesis& b) { return a.cloud_score > b.cloud_score; };
-  for (Hypothesis& h : hypotheses) settle(h);
+  // Hypotheses settle independently (in parallel: a few thousand points each keep one core busy).
+  auto settle_all = [&](std::vector<Hypothesis>& list) {
+    tbb::parallel_for(std::size_t{0}, list.size(), [&](std::size_t i) { settle(list[i]); });
+  };
+  settle_all(hypotheses);
   std::stable_sort(hypotheses.begin(), hypotheses.end(), by_score);
   // 4PCS on a symmetric room often finds only the flipped pose; its symmetric twin must compete too.
   if (!hypotheses.empty()) {
-    const Hypothesis best = hypotheses.front();
-    // The estimated centre can put a twin a metre or two off, beyond the guard's ICP stages: two coarser
-    // stages (4 and 8 times the coarsest spacing, a few thousand points) pull it in first.
-    IcpParams wide;
-    wide.voxel_m = 2.0 * source.stages.front().voxel_m;
-    wide.stages = 2;
-    wide.max_iterations = 10;
-    const IcpPyramid wide_source = make_icp_pyramid(source.stages.front().points, wide, false, cancel);
-    const IcpPyramid wide_target = make_icp_pyramid(target.stages.front().points, wide, true, cancel);
-    for (const Eigen::Matrix4d& s : principal_half_turns(target.stages.front().points)) {
-      Hypothesis twin{s * best.transform, 0.0, 0.0};
-      twin.transform = refine_icp(wide_source, wide_target, twin.transform, wide, cancel).transform;
-      settle(twin);
-      hypotheses.push_back(twin);
-    }
+    std::vector<Hypothesis> twins;
+    for (const Eigen::Matrix4d& s : principal_half_turns(target.stages.front().points))
+      twins.push_back({s * hypotheses.front().transform, 0.0, 0.0});
+    settle_all(twins);
+    hypotheses.insert(hypotheses.end(), twins.begin(), twins.end());
     std::stable_sort(hypotheses.begin(), hypotheses.end(), by_score);
   }
   SymmetryGuardResult result;

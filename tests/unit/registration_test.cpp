@@ -222,6 +222,21 @@ TEST(Registration, NoHypothesisIsFailedPrecondition) {
   EXPECT_EQ(code, ErrorCode::kFailedPrecondition);
 }
 
+// Many files carry an intensity field that says nothing (e.g. a constant): with the signal on auto, the
+// intensity attempt finds no keypoints, and the geometric signal takes over. Asked for intensity
+// explicitly, the registration fails instead of second-guessing.
+TEST(Registration, AutoSignalFallsBackToGeometryWhereIntensityCarriesNothing) {
+  const GtPair pair = bunny_pair("bun045.ply", "bun000.ply");
+  PointCloud source = read_cloud(kBunny + pair.source), target = read_cloud(kBunny + pair.target);
+  for (PointCloud* cloud : {&source, &target}) cloud->intensity.assign(cloud->size(), 0.5f);
+  const RegistrationResult r = register_clouds(source, target, bunny_params(pair.overlap));
+  EXPECT_EQ(r.signal, "geometric");
+  EXPECT_LT(transform_error(source.points, r.transform, pair.T_target_source).rmse_m, kBunnySuccess_m);
+  RegistrationParams intensity = bunny_params(pair.overlap);
+  intensity.signal = KeypointSignal::kIntensity;
+  EXPECT_EQ(test::error_code_of([&] { register_clouds(source, target, intensity); }), ErrorCode::kFailedPrecondition);
+}
+
 TEST(Registration, PlainFourPcsBaselineIsSelectable) {
   const GtPair pair = bunny_pair("bun045.ply", "bun000.ply");
   const PointCloud source = read_cloud(kBunny + pair.source), target = read_cloud(kBunny + pair.target);

@@ -20,13 +20,13 @@ enum class CoarseMethod {
 };
 
 enum class KeypointSignal {
-  kAuto,        // intensity when both clouds have it, otherwise geometric
+  kAuto,        // intensity when both clouds have it (geometric too if its pose is weak), else geometric
   kIntensity,   // DoG of the (voxel-averaged) intensity
   kGeometric,   // DoG of the surface variation from local PCA (clouds without intensity)
 };
 
 enum class FreeSpaceCheck {
-  kAuto,  // on when both scans look like terrestrial scans taken from their frame's origin
+  kAuto,  // on when both scans look like terrestrial scans taken from (and around) their frame's origin
   kOn,
   kOff,
 };

@@ -2,9 +2,11 @@
 // each distinct 4PCS hypothesis is settled by a short coarse ICP and re-scored on the voxelised clouds,
 // where the furniture that breaks a room's symmetry is visible: how much of the source the target
 // covers, less how much of it lands in space the target scanner saw to be empty (points the target
-// scanner could not see are no evidence). 4PCS on a symmetric room often finds only the flipped pose,
-// so the best hypothesis's twins under half turns about the target's principal axes compete too.
-// Cost: a few ICP iterations and one pass over the coarse source per hypothesis, plus three twins.
+// scanner could not see, or saw from the other side of their surface, are no evidence). 4PCS on a
+// symmetric room often finds only the flipped pose, so the best hypothesis's twins under half turns
+// about the target's principal axes compete too.
+// Cost per hypothesis (and per each of three twins): a few ICP iterations on a few thousand points
+// from two starts and up to two passes over the coarse source.
 #pragma once
 
 #include <vector>
@@ -22,9 +24,18 @@ struct SymmetryGuardResult {
   double ambiguity_margin = 1.0;       // (best - runner-up) / best; 1 when there is no runner-up
 };
 
-// Uses the two coarsest levels of the ICP pyramids and scores on the second. free_space may be null.
+// What is known of the two scans' viewpoints (terrestrial scans; null for object scans): the target
+// scanner's free space and both scanner positions, each in its own scan's local frame.
+struct ScanViews {
+  const FreeSpaceImage* target_free_space = nullptr;
+  Eigen::Vector3f source_scanner_m = Eigen::Vector3f::Zero();
+  Eigen::Vector3f target_scanner_m = Eigen::Vector3f::Zero();
+};
+
+// Uses the two coarsest levels of the ICP pyramids and scores on the second. overlap: the expected share
+// of the source the target sees (the registration's parameter).
 SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& target,
-                                    std::vector<Hypothesis> hypotheses, const FreeSpaceImage* free_space,
+                                    std::vector<Hypothesis> hypotheses, double overlap, const ScanViews* views,
                                     const CancellationToken* cancel = nullptr);
 
 }  // namespace k4reg
