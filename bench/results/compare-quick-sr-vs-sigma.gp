@@ -17,10 +17,10 @@ $d1 << EOD
 50 100 
 EOD
 $d2 << EOD
-50 66.6667 
+50 55.5556 
 EOD
 $d3 << EOD
-50 44.4444 
+50 66.6667 
 EOD
 plot $d0 with linespoints lw 2 pt 5 ps 1.5 title 'K-4PCS k4reg 0.7M', \
      $d1 with linespoints lw 2 pt 7 ps 1.5 title 'K-4PCS k4reg 2.5M', \

@@ -10,12 +10,12 @@ set logscale xy
 set xrange [0.5:14]
 set xtics (0.7, 2.5, 10)
 $d0 << EOD
-0.7 1.28445 0.887211 1.42327 
-2.5 2.19178 1.40175 2.88554 
+0.7 1.52348 1.15597 1.97117 
+2.5 2.48884 1.67659 2.95391 
 EOD
 $d1 << EOD
-0.7 5.16145 4.38896 8.45364 
-2.5 7.3693 6.24063 11.1515 
+0.7 5.76511 4.75797 8.30439 
+2.5 9.93384 8.28523 13.8136 
 EOD
 plot $d0 with yerrorlines lw 2 pt 5 ps 1.5 title 'K-4PCS k4reg σ 50 mm', \
      $d1 with yerrorlines lw 2 pt 7 ps 1.5 title 'K-4PCS PCL σ 50 mm'
