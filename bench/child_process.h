@@ -13,6 +13,7 @@ struct ChildOutcome {
   std::string output;       // everything the child wrote to stdout
   double peak_rss_mb = 0.0;
   double wall_s = 0.0;
+  double cpu_s = 0.0;       // user + system time of the child and its threads
 };
 
 // argv[0] must be a path. stderr is inherited. Throws std::runtime_error when the process cannot start.

@@ -18,7 +18,7 @@ inline constexpr const char* kPclPlain = "4pcs-pcl";        // VoxelGrid + FPCSI
 inline constexpr const char* kOursMatch = "match-ours";     // match_4pcs on given keypoints (ETH office)
 inline constexpr const char* kPclMatch = "match-pcl";       // KFPCSInitialAlignment on given keypoints
 inline constexpr const char* kKeypointsOurs = "keypoints-ours";  // our detector once per pair: counts, repeatability
-inline constexpr const char* kKeypointsPcl = "keypoints-pcl";    // PCL's SIFTKeypoint likewise
+inline constexpr const char* kKeypointsPcl = "keypoints-pcl";    // PCL's SIFTKeypoint likewise, kept for the trials
 
 // PCL checks its time cap only between iterations (and SIFTKeypoint has none), so the orchestrator kills
 // a run still going kHardLimitSlack_s after its cap.
@@ -39,6 +39,7 @@ struct Job {
   int pcl_iterations = 100;     // PCL's setMaximumIterations
   int cap_s = 600;              // wall-time cap of one run (PCL: setMaxComputationTime; ours: time_budget_s)
   int memory_cap_mb = 12000;    // address-space limit of the worker: a run past it fails (bad_alloc)
+  std::string sift_cache_dir;   // PCL's SIFT keypoints per scan (see sift_cache.h); "" = computed in every run
 };
 
 void to_json(nlohmann::json& j, const Job& job);

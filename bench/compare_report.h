@@ -30,7 +30,9 @@ struct Suite {
   bool keypoints_given = false;     // the clouds are keypoints (ETH office): only the 4PCS stage runs
   bool baseline = true;             // also run plain 4PCS (ours and PCL) ...
   std::size_t baseline_size = 0;    // ... at this scan size only (0 = every size) ...
-  int baseline_trials = 0;          // ... with this many trials (0 = trials)
+  int baseline_trials = 0;          // ... with this many trials (0 = trials) ...
+  double baseline_sigma_m = 0;      // ... at this sigma only (0 = every sigma) ...
+  std::vector<std::string> baseline_pairs{};  // ... on these pairs only (empty = every pair)
 };
 
 struct Case {
@@ -57,6 +59,8 @@ struct Run {
   double total_s = 0, read_s = 0, convert_s = 0, peak_rss_mb = 0;
   std::size_t source_keypoints = 0, target_keypoints = 0;
   int sift_overflow_octaves = 0;
+  int attempts = 1;          // > 1: repeated because other processes used the CPU (see machine_load.h)
+  double foreign_cores = 0;  // cores other processes used on average during the attempt that stands
 };
 
 // A detector run once per case (detectors are deterministic): counts, repeatability, time.
@@ -67,6 +71,8 @@ struct DetectorStats {
   std::size_t source = 0, target = 0;
   double repeatability = 0, seconds = 0, peak_rss_mb = 0;
   int sift_overflow_octaves = 0;    // PCL only
+  int attempts = 1;
+  double foreign_cores = 0;
 };
 
 struct KeypointStats {
@@ -79,7 +85,8 @@ struct KeypointStats {
 struct Report {
   std::string mode;                 // "quick" or "full"
   std::string started, command;
-  double duration_s = 0;
+  double duration_s = 0;            // machine time, summed over the sessions of a resumed comparison
+  int sessions = 1;
   std::vector<Suite> suites;
   std::vector<Case> cases;
   std::vector<KeypointStats> keypoints;  // parallel to cases

@@ -6,7 +6,9 @@
 // source_keypoints, target_keypoints, capped (over the wall-time cap: a failure), coarse and final
 // {mae_deg, mte_m, rotation_deg, translation_m, rmse_m} (coarse = before ICP; PCL has no ICP, so they
 // are equal), sift_overflow_octaves. The keypoint jobs report seconds, source_keypoints, target_keypoints,
-// repeatability, and truth_overlap / plain_voxel_m (ours) or sift_overflow_octaves (PCL). A worker prints
+// repeatability, and truth_overlap / plain_voxel_m (ours) or sift_overflow_octaves (PCL). PCL's K-4PCS
+// and SIFT runs also report sift_peak_rss_mb (of the process that computed the keypoints, see
+// sift_cache.h) and, when SIFT was killed on that scan before, sift_timed_out. A worker prints
 // "PROGRESS {...}" lines with facts known before a long stage, then one "RESULT {...}" line.
 #include <Eigen/Geometry>
 #include <sys/resource.h>
@@ -28,6 +30,7 @@
 #include "k4reg/surface_signal.h"
 #include "k4reg/voxel_grid.h"
 #include "pcl_methods.h"
+#include "sift_cache.h"
 #include "truth_error.h"
 
 namespace k4reg::bench {
@@ -40,7 +43,8 @@ void to_json(json& j, const Job& job) {
            {"unit_scale", job.unit_scale}, {"max_range_m", job.max_range_m}, {"pose_seed", job.pose_seed},
            {"sigma_m", job.sigma_m},     {"overlap", job.overlap},     {"plain_voxel_m", job.plain_voxel_m},
            {"seed", job.seed},           {"max_bases", job.max_bases}, {"pcl_iterations", job.pcl_iterations},
-           {"cap_s", job.cap_s},         {"memory_cap_mb", job.memory_cap_mb}};
+           {"cap_s", job.cap_s},         {"memory_cap_mb", job.memory_cap_mb},
+           {"sift_cache_dir", job.sift_cache_dir}};
   j["truth"] = std::vector<double>(job.truth.data(), job.truth.data() + 16);  // column-major
 }
 
@@ -59,6 +63,7 @@ void from_json(const json& j, Job& job) {
   j.at("pcl_iterations").get_to(job.pcl_iterations);
   j.at("cap_s").get_to(job.cap_s);
   j.at("memory_cap_mb").get_to(job.memory_cap_mb);
+  j.at("sift_cache_dir").get_to(job.sift_cache_dir);
   const auto truth = j.at("truth").get<std::vector<double>>();
   if (truth.size() != 16) throw std::runtime_error("job: truth needs 16 numbers");
   job.truth = Eigen::Map<const Eigen::Matrix4d>(truth.data());
@@ -72,10 +77,12 @@ void report_progress(const json& facts) {
   std::fflush(stdout);
 }
 
-// SIFT's VoxelGrid overflow is known from the bounding boxes before SIFT starts (and explains a slow SIFT).
-void report_sift_overflow(const PclCloud& source, const PclCloud& target, const SiftParams& sift) {
-  report_progress({{"sift_overflow_octaves", std::max(sift_overflowed_octaves(source, sift),
-                                                      sift_overflowed_octaves(target, sift))}});
+// The cache key of a cloud exactly as load_pair makes it from `file`.
+std::string scan_key(const std::string& file, const Job& job, std::uint64_t pose_seed) {
+  char buffer[96];
+  std::snprintf(buffer, sizeof buffer, "|scale=%.9g|range=%.9g|pose=%llu", job.unit_scale, job.max_range_m,
+                static_cast<unsigned long long>(pose_seed));
+  return file + buffer;
 }
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
@@ -173,6 +180,37 @@ json stage_times(const std::vector<StageTiming>& timings) {
   return stages;
 }
 
+struct PairSift {
+  SceneSift source, target;
+  double seconds() const { return source.seconds + target.seconds; }
+  double peak_rss_mb() const { return std::max(source.peak_rss_mb, target.peak_rss_mb); }
+  int overflowed_octaves() const { return std::max(source.overflowed_octaves, target.overflowed_octaves); }
+};
+
+// PCL's SIFT keypoints of both scans, from the cache when an earlier job computed them (SIFT is
+// deterministic). SIFT's VoxelGrid overflow is reported before SIFT starts: it explains a killed run.
+PairSift pcl_sift(const Job& job, const LoadedPair& pair) {
+  const SiftParams sift{job.sigma_m};
+  const bool intensity = pair.source.has_intensity() && pair.target.has_intensity();
+  int overflowed = 0;
+  const auto report_overflow = [&](const PclCloud& cloud) {
+    overflowed = std::max(overflowed, sift_overflowed_octaves(cloud, sift));
+    report_progress({{"sift_overflow_octaves", overflowed}});
+  };
+  const SiftCache cache(job.sift_cache_dir);
+  PairSift out;
+  out.source = cache.keypoints(pair.source, scan_key(job.source, job, job.pose_seed), intensity, sift, job.cap_s,
+                               report_overflow);
+  out.target = cache.keypoints(pair.target, scan_key(job.target, job, 0), intensity, sift, job.cap_s, report_overflow);
+  return out;
+}
+
+PclCloud::Ptr pcl_points(const std::vector<Eigen::Vector3f>& points) {
+  PointCloud cloud;
+  cloud.points = points;
+  return to_pcl(cloud);
+}
+
 void run_ours(const Job& job, const LoadedPair& pair, json& out) {
   RegistrationParams params;
   params.min_scale_m = job.sigma_m;
@@ -200,24 +238,21 @@ PclAlignParams pcl_align_params(const Job& job, double delta_m) {
 }
 
 void run_pcl(const Job& job, const LoadedPair& pair, json& out) {
-  auto start = Clock::now();
-  const PclCloud::Ptr source = to_pcl(pair.source), target = to_pcl(pair.target);
-  out["convert_s"] = seconds_since(start);
-
   json stages = json::object();
   PclCloud::Ptr source_set, target_set;
   double delta = job.sigma_m;
-  start = Clock::now();
   if (job.method == kPclK4pcs) {
-    const SiftParams sift{job.sigma_m};
-    const bool intensity = pair.source.has_intensity() && pair.target.has_intensity();
-    report_sift_overflow(*source, *target, sift);
-    const SiftKeypoints s = pcl_sift_keypoints(source, intensity, sift), t = pcl_sift_keypoints(target, intensity, sift);
-    out["sift_overflow_octaves"] = std::max(s.overflowed_octaves, t.overflowed_octaves);
-    source_set = s.points, target_set = t.points;
-    stages["keypoints"] = seconds_since(start);
+    const PairSift sift = pcl_sift(job, pair);
+    out["sift_overflow_octaves"] = sift.overflowed_octaves();
+    out["sift_peak_rss_mb"] = sift.peak_rss_mb();
+    source_set = pcl_points(sift.source.points), target_set = pcl_points(sift.target.points);
+    stages["keypoints"] = sift.seconds();
   } else {
+    auto start = Clock::now();
+    const PclCloud::Ptr source = to_pcl(pair.source), target = to_pcl(pair.target);
+    out["convert_s"] = seconds_since(start);
     delta = job.plain_voxel_m;
+    start = Clock::now();
     source_set = pcl_voxel_grid(source, delta), target_set = pcl_voxel_grid(target, delta);
     out["voxel_grid_overflow"] = pcl_voxel_grid_overflows(*source, delta) || pcl_voxel_grid_overflows(*target, delta);
     stages["plain_grid"] = seconds_since(start);
@@ -226,7 +261,7 @@ void run_pcl(const Job& job, const LoadedPair& pair, json& out) {
   out["target_keypoints"] = target_set->size();
   if (source_set->size() < 4 || target_set->size() < 4) fail(ErrorCode::kFailedPrecondition, "too few keypoints");
 
-  start = Clock::now();
+  const auto start = Clock::now();
   const PclAlignParams params = pcl_align_params(job, delta);
   const Eigen::Matrix4d local = job.method == kPclK4pcs ? pcl_kfpcs(source_set, target_set, params)
                                                        : pcl_fpcs(source_set, target_set, params);
@@ -296,20 +331,19 @@ void run_keypoints(const Job& job, const LoadedPair& pair, json& out) {
   const bool intensity = pair.source.has_intensity() && pair.target.has_intensity();
   const Eigen::Matrix4d truth_local = local_from_file(pair.truth, pair.source, pair.target);
   std::vector<Eigen::Vector3f> source, target;
-  const auto start = Clock::now();
   if (job.method == kKeypointsOurs) {
+    const auto start = Clock::now();
     source = our_keypoints(pair.source, intensity, sigma);
     target = our_keypoints(pair.target, intensity, sigma);
+    out["seconds"] = seconds_since(start);
   } else {
-    const SiftParams sift{sigma};
-    const PclCloud::Ptr source_pcl = to_pcl(pair.source), target_pcl = to_pcl(pair.target);
-    report_sift_overflow(*source_pcl, *target_pcl, sift);
-    const SiftKeypoints s = pcl_sift_keypoints(source_pcl, intensity, sift);
-    const SiftKeypoints t = pcl_sift_keypoints(target_pcl, intensity, sift);
-    source = to_points(*s.points), target = to_points(*t.points);
-    out["sift_overflow_octaves"] = std::max(s.overflowed_octaves, t.overflowed_octaves);
+    const PairSift sift = pcl_sift(job, pair);
+    source = sift.source.points, target = sift.target.points;
+    out["seconds"] = sift.seconds();
+    out["sift_overflow_octaves"] = sift.overflowed_octaves();
+    out["sift_peak_rss_mb"] = sift.peak_rss_mb();
+    out["sift_from_cache"] = sift.source.from_cache && sift.target.from_cache;
   }
-  out["seconds"] = seconds_since(start);
   out["source_keypoints"] = source.size();
   out["target_keypoints"] = target.size();
   out["repeatability"] = repeatability(source, target, truth_local, 2.0 * sigma);
@@ -338,6 +372,9 @@ json run_job(const Job& job) {
   } catch (const Error& e) {
     out["error"] = std::string(to_string(e.code())) + ": " + e.what();
     out["capped"] = e.code() == ErrorCode::kDeadlineExceeded;
+  } catch (const SiftTimedOutEarlier& e) {
+    out["error"] = e.what();
+    out["sift_timed_out"] = true;
   } catch (const std::bad_alloc&) {
     out["error"] = "out of memory (over the " + std::to_string(job.memory_cap_mb) + " MB cap)";
   } catch (const std::exception& e) {
