@@ -37,13 +37,13 @@ double robust_diameter(const std::vector<Eigen::Vector3f>& points) {
   return extent.norm();
 }
 
-// MSAC-style score: each point contributes 1 - d^2/tau^2 when within tau of a target point, and -1
-// when it lands in the target scanner's observed free space.
+// MSAC-style score: each point contributes 1 - d^2/tau^2 when within tau of a target point. (Free space
+// is left to the symmetry guard, which scores whole clouds; keypoints are too few to profit from it.)
 class Verifier {
  public:
   Verifier(const std::vector<Eigen::Vector3f>& source, const std::vector<Eigen::Vector3f>& target, double tau_m,
-           int max_points, std::uint64_t seed, const FreeSpaceImage* free_space)
-      : grid_(target, 2.0 * tau_m), tau_(static_cast<float>(tau_m)), free_space_(free_space) {  // 8-cell look-ups
+           int max_points, std::uint64_t seed)
+      : grid_(target, 2.0 * tau_m), tau_(static_cast<float>(tau_m)) {  // 8-cell look-ups
     std::vector<std::uint32_t> order(source.size());
     std::iota(order.begin(), order.end(), 0);
     std::mt19937_64 rng(seed);
@@ -62,10 +62,7 @@ class Verifier {
     for (std::size_t k = 0; k < count; ++k) {
       float d2 = 0;
       const Eigen::Vector3f q = a * points_[k];
-      if (grid_.nearest_within(q, tau_, &d2) >= 0)
-        s += 1.0 - d2 * inv_tau2;
-      else if (free_space_ && free_space_->contradicts(q))
-        s -= 1.0;
+      if (grid_.nearest_within(q, tau_, &d2) >= 0) s += 1.0 - d2 * inv_tau2;
       if (s + static_cast<double>(count - k - 1) < beat) return -1.0;
     }
     return s;
@@ -74,7 +71,6 @@ class Verifier {
  private:
   NeighborGrid grid_;
   float tau_;
-  const FreeSpaceImage* free_space_;
   std::vector<Eigen::Vector3f> points_;
 };
 
@@ -147,8 +143,7 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
   const double max_width = std::max(params.overlap * robust_diameter(source), 10.0 * params.delta_m);
   const double min_width = std::max(0.1 * max_width, 4.0 * params.delta_m);
   const PairIndex pairs(target, min_width - tolerance.pair_m, max_width + tolerance.pair_m, cancel);
-  const Verifier verifier(source, target, kInlierFactor * params.delta_m, params.verification_points, params.seed,
-                         params.target_free_space);
+  const Verifier verifier(source, target, kInlierFactor * params.delta_m, params.verification_points, params.seed);
   const int bases = params.max_bases > 0 ? params.max_bases : bases_for_overlap(params.overlap);
 
   std::vector<BaseOutcome> outcomes(bases);

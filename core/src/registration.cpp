@@ -220,7 +220,7 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
     out.source_keypoints = source_set.size();
     out.target_keypoints = target_set.size();
 
-    // 3. 4PCS on the two point sets (paper Sec. 2.2), scored with the target's free space when known.
+    // 3. 4PCS on the two point sets (paper Sec. 2.2).
     const FourPcsResult matched = timer.run("matching", [&] {
       FourPcsParams four{delta, params.overlap, params.max_bases, params.hypotheses_kept, params.seed};
       return match_4pcs(source_set, target_set, four, cancel, progress);

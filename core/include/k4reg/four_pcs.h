@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "k4reg/cancellation.h"
-#include "k4reg/free_space.h"
 #include "k4reg/registration.h"
 
 namespace k4reg {
@@ -21,9 +20,6 @@ struct FourPcsParams {
   int hypotheses_kept = 5;
   std::uint64_t seed = 42;
   int verification_points = 1000;  // source points scored per hypothesis
-  // The target scan's free space (target frame), or null: a source point landing where the target
-  // scanner saw through empty space costs as much as an inlier earns.
-  const FreeSpaceImage* target_free_space = nullptr;
 };
 
 struct FourPcsResult {

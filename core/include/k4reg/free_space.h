@@ -24,7 +24,6 @@ class FreeSpaceImage {
     kOccluded,  // q lies behind the first return
   };
   Seen classify(const Eigen::Vector3f& q) const;
-  bool contradicts(const Eigen::Vector3f& q) const { return classify(q) == Seen::kEmpty; }
 
   // Median distance of the points from the scanner: small values mean the origin is not a scanner
   // position (e.g. object scans whose frame origin is inside the object).
