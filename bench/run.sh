@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# bench/run.sh [--quick] [--table2]
+# bench/run.sh [--quick] [--table2] [--resume]
 # Builds the benchmarks, runs the voxel grid benchmark (Google Benchmark, 5 repetitions, medians), the read
 # throughput of every scan format (k4reg-bench-read, 10 M points, about half a minute) and the K-4PCS / 4PCS
 # comparison with PCL 1.13, then rewrites the machine, voxel, read and compare blocks of bench/RESULTS.md and the
@@ -7,6 +7,8 @@
 # paper's Table 2 for our K-4PCS (k4reg-bench-table2: its table2 block and results/table2-*.csv).
 # --quick: a representative subset (about 20 min on 2 cores; Table 2 is left out to stay within that).
 #   Without it: the full suites (hours).
+# --resume: continue an interrupted comparison from its journal (bench/results/compare-<mode>-journal.jsonl):
+#   the runs already made are kept, only the missing ones run (same build and options).
 # --table2: only k4reg-bench-table2: with --quick its 0.7M, sigma = 50 mm row (all 15 pairs x 10 seeds, about
 #   3 min on 2 cores), without it the full grid of 3 sizes x 3 sigmas (about an hour on 2 cores).
 # Not part of the test suite. Build directory: $K4REG_BENCH_BUILD_DIR (default build-bench).
@@ -15,12 +17,14 @@ cd "$(dirname "$0")/.."
 
 mode=full
 quick_flag=()
+resume_flag=()
 table2_only=false
 for arg in "$@"; do
   case "$arg" in
     --quick) mode=quick; quick_flag=(--quick) ;;
     --table2) table2_only=true ;;
-    *) echo "usage: bench/run.sh [--quick] [--table2]" >&2; exit 2 ;;
+    --resume) resume_flag=(--resume) ;;
+    *) echo "usage: bench/run.sh [--quick] [--table2] [--resume]" >&2; exit 2 ;;
   esac
 done
 build=${K4REG_BENCH_BUILD_DIR:-build-bench}
@@ -95,8 +99,8 @@ replace_block "$markdown" read "$read_table"
   --benchmark_out="$results/voxel_grid_bench.json" --benchmark_out_format=json
 "$compare" voxel-report --json "$results/voxel_grid_bench.json" --markdown "$markdown" > /dev/null
 
-"$compare" "${quick_flag[@]}" --cache-dir "$build/bench-cache" --results-dir "$results" --markdown "$markdown" \
-  2>&1 | tee "$results/compare-$mode.log"
+"$compare" "${quick_flag[@]}" "${resume_flag[@]}" --cache-dir "$build/bench-cache" --results-dir "$results" \
+  --markdown "$markdown" 2>&1 | tee ${resume_flag:+-a} "$results/compare-$mode.log"
 
 if command -v gnuplot > /dev/null; then
   for plot in "$results"/compare-"$mode"-*.gp; do
