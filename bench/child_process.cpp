@@ -65,6 +65,7 @@ ChildOutcome run_child(const std::vector<std::string>& argv, double time_limit_s
   }
   outcome.wall_s = elapsed();
   outcome.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  outcome.signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
   outcome.peak_rss_mb = usage.ru_maxrss / 1024.0;  // Linux reports KiB
   const auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + t.tv_usec / 1e6; };
   outcome.cpu_s = seconds(usage.ru_utime) + seconds(usage.ru_stime);

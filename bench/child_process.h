@@ -9,6 +9,7 @@ namespace k4reg::bench {
 
 struct ChildOutcome {
   int exit_code = -1;       // -1 when killed by a signal
+  int signal = 0;           // the signal that killed it, or 0
   bool timed_out = false;   // killed after the time limit
   std::string output;       // everything the child wrote to stdout
   double peak_rss_mb = 0.0;

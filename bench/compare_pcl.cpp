@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <ctime>
@@ -25,6 +26,7 @@
 #include <limits>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 
 #include "child_process.h"
 #include "compare_job.h"
@@ -263,12 +265,22 @@ struct MeasuredOutcome {
   double foreign_cores = 0;
 };
 
+// A worker stopped from outside (the session ends, someone presses Ctrl-C): the comparison stops too,
+// without journaling that run as a failure, and --resume continues it.
+struct Interrupted : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 MeasuredOutcome run_measured(const Job& job) {
   MeasuredOutcome m;
   for (;;) {
     const double busy = machine_busy_cpu_s();
     m.child = run_worker(job);
     ++m.attempts;
+    const int signal = m.child.signal;
+    if (!m.child.timed_out && (signal == SIGTERM || signal == SIGINT || signal == SIGHUP || signal == SIGKILL))
+      throw Interrupted("a worker was stopped from outside (signal " + std::to_string(signal) +
+                        "); the journal has every finished run: continue with --resume");
     const double foreign_s = machine_busy_cpu_s() - busy - m.child.cpu_s;
     m.foreign_cores = std::max(0.0, foreign_s / std::max(m.child.wall_s, 1e-3));
     if (m.foreign_cores <= kMaxForeignCores || foreign_s < kMinForeignCpu_s || m.attempts == kMaxAttempts) return m;
