@@ -34,14 +34,16 @@ NeighborGrid::NeighborGrid(const std::vector<Eigen::Vector3f>& points, double ce
   for (std::size_t k = 0; k < points.size(); ++k) sorted_[k] = points[order_[k]];
 
   // Cells next to occupied ones, then each one's occupied neighbours (counted, filled, sorted by key).
+  // f(key, code) for the 27 cells around occupied cell c; code = (x + 1) + 3 (y + 1) + 9 (z + 1).
   auto adjacent_keys = [&](std::uint32_t c, auto&& f) {
     for (int z = -1; z <= 1; ++z)
       for (int y = -1; y <= 1; ++y)
-        for (int x = -1; x <= 1; ++x) f(pack_voxel_key(index_of[c] + Eigen::Vector3i(x, y, z)));
+        for (int x = -1; x <= 1; ++x)
+          f(pack_voxel_key(index_of[c] + Eigen::Vector3i(x, y, z)), (x + 1) + 3 * (y + 1) + 9 * (z + 1));
   };
   std::vector<std::uint32_t> near_counts;
   for (std::uint32_t c = 0; c < counts.size(); ++c)
-    adjacent_keys(c, [&](std::uint64_t key) {
+    adjacent_keys(c, [&](std::uint64_t key, int) {
       bool inserted = false;
       const std::uint32_t near =
           near_map_.find_or_insert(key, static_cast<std::uint32_t>(near_counts.size()), inserted);
@@ -50,16 +52,22 @@ NeighborGrid::NeighborGrid(const std::vector<Eigen::Vector3f>& points, double ce
     });
   near_offsets_.assign(near_counts.size() + 1, 0);
   for (std::size_t n = 0; n < near_counts.size(); ++n) near_offsets_[n + 1] = near_offsets_[n] + near_counts[n];
-  near_cells_.resize(near_offsets_.back());
+  // Each entry as (code << 32 | cell); cell c lies at minus the offset it was reached by from the listing cell.
+  std::vector<std::uint64_t> entries(near_offsets_.back());
   std::vector<std::uint32_t> next(near_offsets_.begin(), near_offsets_.end() - 1);
   for (std::uint32_t c = 0; c < counts.size(); ++c)
-    adjacent_keys(c, [&](std::uint64_t key) { near_cells_[next[near_map_.find(key)]++] = c; });
-  // Packed keys order cells by z, then y, then x.
+    adjacent_keys(c, [&](std::uint64_t key, int code) {
+      entries[next[near_map_.find(key)]++] = (static_cast<std::uint64_t>(26 - code) << 32) | c;
+    });
+  // Ascending codes are the z, y, x order of packed keys (the general loop's order).
   for (std::size_t n = 0; n < near_counts.size(); ++n)
-    std::sort(near_cells_.begin() + near_offsets_[n], near_cells_.begin() + near_offsets_[n + 1],
-              [&](std::uint32_t a, std::uint32_t b) {
-                return pack_voxel_key(index_of[a]) < pack_voxel_key(index_of[b]);
-              });
+    std::sort(entries.begin() + near_offsets_[n], entries.begin() + near_offsets_[n + 1]);
+  near_cells_.resize(entries.size());
+  near_codes_.resize(entries.size());
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    near_cells_[k] = static_cast<std::uint32_t>(entries[k]);
+    near_codes_[k] = static_cast<std::uint8_t>(entries[k] >> 32);
+  }
 }
 
 }  // namespace k4reg
