@@ -66,8 +66,8 @@ Accumulation accumulate(const std::vector<Eigen::Vector3f>& source, const std::v
 
 }  // namespace
 
-std::vector<Eigen::Vector3f> estimate_normals(const std::vector<Eigen::Vector3f>& points, double radius_m) {
-  const NeighborGrid grid(points, radius_m);
+std::vector<Eigen::Vector3f> estimate_normals(const std::vector<Eigen::Vector3f>& points, const NeighborGrid& grid,
+                                              double radius_m) {
   std::vector<Eigen::Vector3f> normals(points.size(), Eigen::Vector3f::Zero());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 4096), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
@@ -100,8 +100,9 @@ IcpPyramid make_icp_pyramid(const std::vector<Eigen::Vector3f>& points, const Ic
     s.voxel_m = params.voxel_m * std::pow(2.0, params.stages - 1 - stage);
     s.points = stage == params.stages - 1 ? points : downsample(points, s.voxel_m);
     if (as_target) {
-      s.normals = estimate_normals(s.points, 2.5 * s.voxel_m);
+      // One grid serves the correspondences and the normals (both look about 2.5 voxels around).
       s.grid = std::make_unique<NeighborGrid>(s.points, params.max_distance_factor * s.voxel_m);
+      s.normals = estimate_normals(s.points, *s.grid, 2.5 * s.voxel_m);
     }
   }
   return pyramid;

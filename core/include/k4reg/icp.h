@@ -47,7 +47,9 @@ IcpPyramid make_icp_pyramid(const std::vector<Eigen::Vector3f>& points, const Ic
 IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const Eigen::Matrix4d& initial,
                      const IcpParams& params, const CancellationToken* cancel = nullptr);
 
-// Normals by local PCA with neighbours within radius_m; zero where fewer than 3 neighbours.
-std::vector<Eigen::Vector3f> estimate_normals(const std::vector<Eigen::Vector3f>& points, double radius_m);
+// Normals by local PCA with neighbours within radius_m (grid: over `points`, cells of about radius_m or
+// more); zero where fewer than 3 neighbours.
+std::vector<Eigen::Vector3f> estimate_normals(const std::vector<Eigen::Vector3f>& points, const NeighborGrid& grid,
+                                              double radius_m);
 
 }  // namespace k4reg
