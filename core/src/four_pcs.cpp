@@ -17,7 +17,7 @@ namespace k4reg {
 namespace {
 
 constexpr int kBatch = 8;               // bases per parallel batch (fixed: determinism)
-constexpr int kPrescreenPoints[] = {40, 200};  // cheap looks before a full verification
+constexpr int kPrescreenPoints[] = {20, 40, 200};  // cheap looks before a full verification
 constexpr std::size_t kMaxSetsPerBase = 20000;     // verified per base (an even subsample)
 constexpr std::size_t kMaxSetsFound = 8 * kMaxSetsPerBase;  // collected per base: bounds memory and time
 constexpr double kInlierFactor = 3.0;   // inlier distance in units of delta
