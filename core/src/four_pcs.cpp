@@ -145,47 +145,65 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
   const PairIndex pairs(target, min_width - tolerance.pair_m, max_width + tolerance.pair_m, cancel);
   const Verifier verifier(source, target, kInlierFactor * params.delta_m, params.verification_points, params.seed);
   const int bases = params.max_bases > 0 ? params.max_bases : bases_for_overlap(params.overlap);
+  const bool labelled = params.source_labels && params.target_labels;
+  if (labelled && (params.source_labels->size() != source.size() || params.target_labels->size() != target.size()))
+    fail(ErrorCode::kInvalidArgument, "4PCS: one label per point is needed");
 
-  std::vector<BaseOutcome> outcomes(bases);
-  double global_best = 0;  // from finished batches only, so pruning does not depend on timing
-  for (int start = 0; start < bases; start += kBatch) {
-    check(cancel);
-    const int end = std::min(bases, start + kBatch);
-    tbb::parallel_for(start, end, [&](int b) {
-      std::seed_seq seq{static_cast<std::uint64_t>(params.seed), static_cast<std::uint64_t>(b)};
-      std::mt19937_64 rng(seq);
-      Base base;
-      if (!select_base(source, min_width, max_width, tolerance.coplanarity_m, rng, base)) return;
-      std::vector<Quadrilateral> sets;
-      find_congruent_sets(base, target, pairs, tolerance, kMaxSetsFound, sets, cancel);
-      BaseOutcome& out = outcomes[b];
-      out.sets = sets.size();
-      // Dense, regular point sets (the plain-4PCS baseline on a grid) give combinatorially many sets;
-      // an even subsample keeps a base's cost bounded.
-      if (sets.size() > kMaxSetsPerBase) {
-        const std::size_t stride = (sets.size() + kMaxSetsPerBase - 1) / kMaxSetsPerBase;
-        for (std::size_t k = 0; k * stride < sets.size(); ++k) sets[k] = sets[k * stride];
-        sets.resize((sets.size() + stride - 1) / stride);
-      }
-      Eigen::Matrix3Xd from(3, 4), to(3, 4);
-      for (int k = 0; k < 4; ++k) from.col(k) = base.point[k].cast<double>();
-      for (std::size_t s = 0; s < sets.size(); ++s) {
-        if ((s & 255) == 0) check(cancel);
-        for (int k = 0; k < 4; ++k) to.col(k) = target[sets[s][k]].cast<double>();
-        const Eigen::Matrix4d t = fit_rigid(from, to);
-        if (fit_rms(t, from, to) > tolerance.fit_rms_m) continue;
-        const double beat = std::max(out.floor(), global_best);
-        // Prescreens on the first points: a hypothesis far below the best so far is not worth a full look.
-        if (!passes_prescreens(verifier, t, 0.5 * beat)) continue;
-        const double full = verifier.score(t, verifier.size(), std::max(out.floor(), 0.5 * global_best));
-        if (full > out.floor() && full > 0)
-          out.offer({full, t}, kDistinctAngle_deg, kDistinctShiftDeltas * params.delta_m);
-      }
-    });
-    for (int b = start; b < end; ++b)
-      if (!outcomes[b].candidates.empty()) global_best = std::max(global_best, outcomes[b].candidates.front().score);
-    if (progress) progress("matching", double(end) / bases);
-  }
+  // Every base's best few candidates (with or without the labels).
+  auto search = [&](bool use_labels) {
+    std::vector<BaseOutcome> outcomes(bases);
+    double global_best = 0;  // from finished batches only, so pruning does not depend on timing
+    for (int start = 0; start < bases; start += kBatch) {
+      check(cancel);
+      const int end = std::min(bases, start + kBatch);
+      tbb::parallel_for(start, end, [&](int b) {
+        std::seed_seq seq{static_cast<std::uint64_t>(params.seed), static_cast<std::uint64_t>(b)};
+        std::mt19937_64 rng(seq);
+        Base base;
+        if (!select_base(source, min_width, max_width, tolerance.coplanarity_m, rng, base)) return;
+        std::vector<Quadrilateral> sets;
+        find_congruent_sets(base, target, pairs, tolerance, kMaxSetsFound, sets, cancel);
+        if (use_labels)
+          std::erase_if(sets, [&](const Quadrilateral& set) {
+            for (int k = 0; k < 4; ++k)
+              if ((*params.target_labels)[set[k]] != (*params.source_labels)[base.index[k]]) return true;
+            return false;
+          });
+        BaseOutcome& out = outcomes[b];
+        out.sets = sets.size();
+        // Dense, regular point sets (the plain-4PCS baseline on a grid) give combinatorially many sets;
+        // an even subsample keeps a base's cost bounded.
+        if (sets.size() > kMaxSetsPerBase) {
+          const std::size_t stride = (sets.size() + kMaxSetsPerBase - 1) / kMaxSetsPerBase;
+          for (std::size_t k = 0; k * stride < sets.size(); ++k) sets[k] = sets[k * stride];
+          sets.resize((sets.size() + stride - 1) / stride);
+        }
+        Eigen::Matrix3Xd from(3, 4), to(3, 4);
+        for (int k = 0; k < 4; ++k) from.col(k) = base.point[k].cast<double>();
+        for (std::size_t s = 0; s < sets.size(); ++s) {
+          if ((s & 255) == 0) check(cancel);
+          for (int k = 0; k < 4; ++k) to.col(k) = target[sets[s][k]].cast<double>();
+          const Eigen::Matrix4d t = fit_rigid(from, to);
+          if (fit_rms(t, from, to) > tolerance.fit_rms_m) continue;
+          const double beat = std::max(out.floor(), global_best);
+          // Prescreens on the first points: a hypothesis far below the best so far is not worth a full look.
+          if (!passes_prescreens(verifier, t, 0.5 * beat)) continue;
+          const double full = verifier.score(t, verifier.size(), std::max(out.floor(), 0.5 * global_best));
+          if (full > out.floor() && full > 0)
+            out.offer({full, t}, kDistinctAngle_deg, kDistinctShiftDeltas * params.delta_m);
+        }
+      });
+      for (int b = start; b < end; ++b)
+        if (!outcomes[b].candidates.empty()) global_best = std::max(global_best, outcomes[b].candidates.front().score);
+      if (progress) progress("matching", double(end) / bases);
+    }
+    return outcomes;
+  };
+  std::vector<BaseOutcome> outcomes = search(labelled);
+  // A handful of keypoints (a small object at a coarse scale) may give no set whose labels agree: chance
+  // sets still give a rough pose that the symmetry guard's ICP can settle, so they get their turn.
+  const auto found = [](const BaseOutcome& o) { return !o.candidates.empty(); };
+  if (labelled && std::none_of(outcomes.begin(), outcomes.end(), found)) outcomes = search(false);
 
   // Distinct hypotheses over all bases, best first (ties to the earlier base: deterministic order).
   std::vector<Candidate> all;

@@ -192,6 +192,7 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
     CoarseAlignment out;
     // 2. The point sets 4PCS runs on: DoG keypoints (K-4PCS) or a coarser voxel grid (plain 4PCS).
     std::vector<Eigen::Vector3f> source_set, target_set;
+    std::vector<std::uint8_t> source_labels, target_labels;  // DoG extremum: 1 maximum, 0 minimum
     if (!plain) {
       timer.run("keypoints", [&] {
         const bool intensity = source.has_intensity() && target.has_intensity();
@@ -199,8 +200,11 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
         for (const auto* voxels : {&source_voxels, &target_voxels}) {
           const SurfaceSignal surface = make_surface_signal(voxels->cloud, sigma, signal, intensity, cancel);
           out.signal = surface.name;
-          auto& set = voxels == &source_voxels ? source_set : target_set;
-          set = detect_dog_keypoints(voxels->cloud.points, surface.values, dog, cancel).points;
+          const bool is_source = voxels == &source_voxels;
+          DogKeypoints keypoints = detect_dog_keypoints(voxels->cloud.points, surface.values, dog, cancel);
+          auto& labels = is_source ? source_labels : target_labels;
+          for (const float response : keypoints.response) labels.push_back(response > 0.0f);
+          (is_source ? source_set : target_set) = std::move(keypoints.points);
         }
         return 0;
       });
@@ -223,6 +227,7 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
     // 3. 4PCS on the two point sets (paper Sec. 2.2).
     const FourPcsResult matched = timer.run("matching", [&] {
       FourPcsParams four{delta, params.overlap, params.max_bases, params.hypotheses_kept, params.seed};
+      if (!plain) four.source_labels = &source_labels, four.target_labels = &target_labels;
       return match_4pcs(source_set, target_set, four, cancel, progress);
     });
     out.bases_tried = matched.bases_tried;

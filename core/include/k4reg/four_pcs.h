@@ -20,6 +20,11 @@ struct FourPcsParams {
   int hypotheses_kept = 5;
   std::uint64_t seed = 42;
   int verification_points = 1000;  // source points scored per hypothesis
+  // Optional, one per point: a congruent set counts only where each target point carries the label of the
+  // base point it stands for. The pipeline labels keypoints by their DoG extremum's sign (a bright blob
+  // can only be a bright blob in the other scan), which removes most chance sets before verification.
+  const std::vector<std::uint8_t>* source_labels = nullptr;
+  const std::vector<std::uint8_t>* target_labels = nullptr;
 };
 
 struct FourPcsResult {
