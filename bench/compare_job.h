@@ -46,8 +46,10 @@ void to_json(nlohmann::json& j, const Job& job);
 void from_json(const nlohmann::json& j, Job& job);
 
 // Limits this process's address space to job.memory_cap_mb (so a runaway run fails instead of pushing a
-// shared machine into the OOM killer).
+// shared machine into the OOM killer). A bad_alloc that escapes where run_job cannot catch it (PCL throws
+// from inside OpenMP regions) still ends the process, but first prints kOutOfMemoryLine.
 void limit_memory(const Job& job);
+inline constexpr const char* kOutOfMemoryLine = "OUT_OF_MEMORY";
 
 // Runs the job in this process and returns the result object (see compare_worker.cpp for the fields).
 nlohmann::json run_job(const Job& job);

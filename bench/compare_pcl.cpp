@@ -293,11 +293,15 @@ MeasuredOutcome run_measured(const Job& job) {
 }
 
 // The worker's RESULT line; for a run that died, the facts of its last PROGRESS line (and an error).
-json worker_result(const ChildOutcome& child, std::string& error) {
+json worker_result(const ChildOutcome& child, int memory_cap_mb, std::string& error) {
   const std::size_t at = child.output.rfind("RESULT ");
   if (at != std::string::npos && !child.timed_out) return json::parse(child.output.substr(at + 7));
-  error = child.timed_out ? "killed after the hard time limit"
-                          : "worker crashed (exit " + std::to_string(child.exit_code) + ")";
+  if (child.timed_out)
+    error = "killed after the hard time limit";
+  else if (child.output.find(std::string("\n") + kOutOfMemoryLine + "\n") != std::string::npos)
+    error = "out of memory (over the " + std::to_string(memory_cap_mb) + " MB cap)";
+  else
+    error = "worker crashed (exit " + std::to_string(child.exit_code) + ")";
   const std::size_t progress = child.output.rfind("PROGRESS ");
   if (progress == std::string::npos) return json::object();
   const std::size_t end = child.output.find('\n', progress);
@@ -324,7 +328,7 @@ Run make_run(const Report& report, std::size_t case_index, const std::string& me
   run.trial = trial;
   run.attempts = measured.attempts;
   run.foreign_cores = measured.foreign_cores;
-  const json r = worker_result(child, run.error);
+  const json r = worker_result(child, report.cases[case_index].job.memory_cap_mb, run.error);
   // PCL's K-4PCS starts from SIFT keypoints computed once per scan: their process's memory counts too.
   run.peak_rss_mb = std::max(child.peak_rss_mb, r.value("sift_peak_rss_mb", 0.0));
   run.capped = child.timed_out || r.value("capped", false);
@@ -357,7 +361,7 @@ DetectorStats run_detector_job(const Case& c, const char* method, KeypointStats&
   DetectorStats d;
   d.attempts = measured.attempts;
   d.foreign_cores = measured.foreign_cores;
-  const json r = worker_result(child, d.error);
+  const json r = worker_result(child, job.memory_cap_mb, d.error);
   d.peak_rss_mb = std::max(child.peak_rss_mb, r.value("sift_peak_rss_mb", 0.0));
   d.timed_out = child.timed_out || r.value("sift_timed_out", false);
   d.ok = r.value("ok", false);

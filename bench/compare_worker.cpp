@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <numbers>
 #include <random>
 
@@ -387,6 +388,16 @@ void limit_memory(const Job& job) {
   const rlim_t bytes = static_cast<rlim_t>(job.memory_cap_mb) << 20;
   const rlimit limit{bytes, bytes};
   setrlimit(RLIMIT_AS, &limit);
+  std::set_terminate([] {
+    try {
+      if (const std::exception_ptr e = std::current_exception()) std::rethrow_exception(e);
+    } catch (const std::bad_alloc&) {
+      std::printf("\n%s\n", kOutOfMemoryLine);
+      std::fflush(stdout);
+    } catch (...) {
+    }
+    std::abort();
+  });
 }
 
 }  // namespace k4reg::bench
