@@ -17,7 +17,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(DetectorStats, ok, timed_out, er
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(KeypointStats, ran, ours, pcl, truth_overlap, plain_voxel_m)
 
 Journal::Journal(const std::string& path, bool resume, std::string session_started)
-    : session_started_(std::move(session_started)) {
+    : path_(path), session_started_(std::move(session_started)) {
   if (resume) {
     std::map<std::string, double> session_lengths;  // by start time
     std::ifstream in(path);
@@ -43,7 +43,9 @@ Journal::Journal(const std::string& path, bool resume, std::string session_start
     for (const auto& [session, length] : session_lengths) replay_.earlier_sessions_s += length;
     replay_.sessions = static_cast<int>(session_lengths.size());
   }
-  out_.open(path, resume ? std::ios::app : std::ios::trunc);
+  // A new journal replaces the old one at once; a resumed one is opened at its first entry (a report from
+  // the journal alone must not create one).
+  if (!resume) out_.open(path, std::ios::trunc);
 }
 
 void Journal::add(const std::string& case_label, const KeypointStats& keypoints, double session_elapsed_s) {
@@ -58,6 +60,7 @@ void Journal::append(json entry, const std::string& case_label, double session_e
   entry["case"] = case_label;
   entry["session"] = session_started_;
   entry["elapsed_s"] = session_elapsed_s;
+  if (!out_.is_open()) out_.open(path_, std::ios::app);
   out_ << entry.dump() << std::endl;  // flushed: the line survives a kill
 }
 

@@ -34,6 +34,7 @@ class Journal {
  private:
   void append(nlohmann::json entry, const std::string& case_label, double session_elapsed_s);
   JournalReplay replay_;
+  std::string path_;
   std::string session_started_;
   std::ofstream out_;
 };

@@ -1,9 +1,9 @@
 // k4reg-bench-compare: K-4PCS and plain 4PCS, k4reg against PCL 1.13, on simulated TLS scans (the
 // paper's indoor lab and outdoor arch, Tables 2-4) and on the real pairs in /work/shared/data.
 //
-//   k4reg-bench-compare [--quick] [--suites lab,arch,real] [--only TEXT] [--trials N] [--resume]
+//   k4reg-bench-compare [--quick] [--suites lab,arch,real] [--only TEXT] [--trials N] [--resume [--redo M | --report-only]]
 //       -> bench/results/compare-<mode>-*.csv, *.gp, the journal compare-<mode>-journal.jsonl (see
-//          compare_journal.h) and the "compare" block of bench/RESULTS.md
+//          compare_journal.h) and the "compare-<mode>" block of bench/RESULTS.md
 //   k4reg-bench-compare worker --job JSON          (one run; used by the orchestrator)
 //   k4reg-bench-compare voxel-report --json FILE   (Google Benchmark JSON -> "voxel" block of RESULTS.md)
 //
@@ -49,6 +49,7 @@ struct Options {
   bool quick = false;
   bool resume = false;
   std::string redo;  // with --resume: methods whose journaled runs are measured again (after a core change)
+  bool report_only = false;  // with --resume: write the outputs from the journal, run nothing
   int trials = -1;  // -1 = the mode's default; 0 = only the keypoint jobs (detectors and truth check)
   std::string suites = "lab,arch,real";
   std::string only;
@@ -435,14 +436,20 @@ int run_comparison(const Options& o, const std::string& command) {
   fs::create_directories(o.results_dir);
   Journal journal(o.results_dir + "/compare-" + report.mode + "-journal.jsonl", o.resume, now_text(true));
   const JournalReplay& replay = journal.replay();
+  if (o.report_only && replay.sessions == 0)
+    throw std::runtime_error("--report-only: nothing journaled yet in " + o.results_dir + " (" + report.mode + " mode)");
   if (!replay.first_started.empty()) report.started = replay.first_started.substr(0, 16) + " UTC";
   bool ran_any = false;  // a resume with nothing left to run only rewrites the outputs
-  if (wait_until_quiet(kMaxForeignCores, kMaxQuietWait_s).waited_s > 10.0) std::printf("waited for a quiet machine\n");
+  if (!o.report_only && wait_until_quiet(kMaxForeignCores, kMaxQuietWait_s).waited_s > 10.0)
+    std::printf("waited for a quiet machine\n");
 
   std::size_t total = 0, done = 0;
   for (const Case& c : report.cases)
     for (int trial = 1; trial <= report.suites[c.suite].trials; ++trial)
-      total += methods_for(report.suites[c.suite], c, trial).size();
+      for (const std::string& method : methods_for(report.suites[c.suite], c, trial)) {
+        ++total;
+        ++report.planned[{c.suite, c.points, c.job.sigma_m, method}];
+      }
   for (std::size_t ci = 0; ci < report.cases.size(); ++ci) {
     Case& c = report.cases[ci];
     const std::string label = case_label(report, c);
@@ -451,6 +458,8 @@ int run_comparison(const Options& o, const std::string& command) {
     const auto redone = [&](const std::string& method) { return ("," + o.redo + ",").find("," + method + ",") != std::string::npos; };
     if (const auto it = replay.keypoints.find(label); it != replay.keypoints.end() && !redone("keypoints")) {
       k = it->second;
+    } else if (o.report_only && !suite.keypoints_given) {
+      continue;  // not reached yet
     } else if (!suite.keypoints_given) {
       k.ran = true;
       k.ours = run_detector_job(c, kKeypointsOurs, k);
@@ -471,6 +480,7 @@ int run_comparison(const Options& o, const std::string& command) {
           report.runs.back().case_index = ci;
           continue;
         }
+        if (o.report_only) continue;
         Job job = c.job;
         job.method = method;
         job.seed = static_cast<std::uint64_t>(trial);
@@ -490,9 +500,10 @@ int run_comparison(const Options& o, const std::string& command) {
   report.sessions = replay.sessions + (ran_any ? 1 : 0);
   report.duration_s = replay.earlier_sessions_s + (ran_any ? elapsed() : 0.0);
   write_outputs(report, o.results_dir);
-  replace_block(o.markdown, "compare", markdown(report, fs::relative(o.results_dir, fs::path(o.markdown).parent_path()).string()));
-  std::printf("comparison finished: %s of machine time in %d session(s) (%s mode, %zu runs); results in %s and %s\n",
-              clock_text(report.duration_s).c_str(), report.sessions, report.mode.c_str(), report.runs.size(),
+  replace_block(o.markdown, "compare-" + report.mode, markdown(report, path_from_markdown(o.markdown, o.results_dir)));
+  std::printf("%s: %s of machine time in %d session(s) (%s mode, %zu of %zu runs); results in %s and %s\n",
+              report.runs.size() < total ? "progress report" : "comparison finished",
+              clock_text(report.duration_s).c_str(), report.sessions, report.mode.c_str(), report.runs.size(), total,
               o.results_dir.c_str(), o.markdown.c_str());
   return 0;
 }
@@ -560,13 +571,17 @@ int main(int argc, char** argv) {
                  "with --resume: measure these methods again, e.g. k4pcs-ours,keypoints after a change to the core "
                  "(PCL's runs do not depend on it)")
       ->needs("--resume");
+  app.add_flag("--report-only", o.report_only,
+               "with --resume: write the CSVs, plots and markdown from the journal so far and run nothing (a "
+               "progress report; rows still missing runs are marked partial)")
+      ->needs("--resume");
   app.add_option("--trials", o.trials, "trials per pair and method (default: 3 quick, 10 full; 0: keypoint jobs only)");
   app.add_option("--suites", o.suites, "comma-separated: lab, arch, real (all real data) or a real set's name")
       ->capture_default_str();
   app.add_option("--only", o.only, "run only the pairs whose label contains this text (e.g. \"lab 0.7M\")");
   app.add_option("--cache-dir", o.cache_dir, "simulated scans are cached here")->capture_default_str();
   app.add_option("--results-dir", o.results_dir, "CSV files and plot scripts go here")->capture_default_str();
-  app.add_option("--markdown", o.markdown, "file whose compare block is replaced")->capture_default_str();
+  app.add_option("--markdown", o.markdown, "file whose compare-<mode> block is replaced")->capture_default_str();
   app.add_option("--data-dir", o.data_dir, "the real data sets")->capture_default_str();
   app.add_option("--memory-cap-mb", o.memory_cap_mb, "address-space limit per run (the machine may be shared)")
       ->capture_default_str();
@@ -590,7 +605,9 @@ int main(int argc, char** argv) {
     }
     if (voxel->parsed()) return voxel_report(voxel_json, o.markdown);
     std::string command = "k4reg-bench-compare";
-    for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+    // A progress report names the command that makes (and continues) the runs it reports.
+    for (int i = 1; i < argc; ++i)
+      if (std::string(argv[i]) != "--report-only") command += std::string(" ") + argv[i];
     return run_comparison(o, command);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "k4reg-bench-compare: %s\n", e.what());

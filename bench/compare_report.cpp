@@ -136,11 +136,26 @@ const Row* find_row(const std::vector<Row>& rows, std::size_t suite, std::size_t
   return nullptr;
 }
 
-// "SR" cell: coarse success rate, with a dagger when some runs hit the wall-time cap.
-std::string sr_cell(const Row* row) {
+// Runs the configuration asks for in this row (0 when unknown).
+std::size_t planned_runs(const Row& row, const Report& report) {
+  const auto it = report.planned.find({row.suite, row.points, row.sigma_m, row.method});
+  return it == report.planned.end() ? 0 : it->second;
+}
+
+// A row of a report made before the comparison finished, with only some of its runs.
+bool partial(const Row& row, const Report& report) { return row.runs.size() < planned_runs(row, report); }
+
+std::string runs_cell(const Row& row, const Report& report) {
+  return std::to_string(row.runs.size()) +
+         (partial(row, report) ? " of " + std::to_string(planned_runs(row, report)) + " ‡" : "");
+}
+
+// "SR" cell: coarse success rate, with a dagger when some runs hit the wall-time cap and a double dagger
+// when the row is still partial.
+std::string sr_cell(const Row* row, const Report& report) {
   if (!row) return "–";
   const std::size_t capped = row->count([](const Run& r) { return r.capped; });
-  return percent(row->success_rate(false)) + (capped ? "†" : "");
+  return percent(row->success_rate(false)) + (capped ? "†" : "") + (partial(*row, report) ? "‡" : "");
 }
 
 std::string rmse_cell(const Row* row) {
@@ -213,8 +228,8 @@ void table2(std::ostringstream& md, const Report& report, const std::vector<Row>
         if (std::abs(p.sigma_mm - sigma * 1000) < 1e-6 && p.points == n)
           paper_kp = std::to_string(p.kp), paper_sr = std::to_string(p.sr) + " %";
       md << " " << number(ours ? keypoints(*ours, report) : kNan, "%.0f") << " / "
-         << number(pcl ? keypoints(*pcl, report) : kNan, "%.0f") << " (" << paper_kp << ") | " << sr_cell(ours) << " / "
-         << sr_cell(pcl) << " (" << paper_sr << ") |";
+         << number(pcl ? keypoints(*pcl, report) : kNan, "%.0f") << " (" << paper_kp << ") | " << sr_cell(ours, report) << " / "
+         << sr_cell(pcl, report) << " (" << paper_sr << ") |";
     }
     md << "\n";
   }
@@ -238,7 +253,7 @@ void comparison_table(std::ostringstream& md, const Report& report, const std::v
     const Row* any = rows4[3] ? rows4[3] : rows4[2] ? rows4[2] : rows4[1] ? rows4[1] : rows4[0];
     md << "| " << sigma_label(sigma) << " | " << (any ? metres(plain_spacing(*any, report)) + " m" : "–");
     for (int m = 0; m < 4; ++m) {
-      md << " | " << sr_cell(rows4[m]) << " | " << rmse_cell(rows4[m]) << " | " << time_median_cell(rows4[m]);
+      md << " | " << sr_cell(rows4[m], report) << " | " << rmse_cell(rows4[m]) << " | " << time_median_cell(rows4[m]);
       if (m >= 2) md << " | " << number(rows4[m] ? keypoints(*rows4[m], report) : kNan, "%.0f");
     }
     std::string paper4 = "–", paperk = "–";
@@ -257,8 +272,8 @@ void real_table(std::ostringstream& md, const Report& report, const std::vector<
      << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& row : rows) {
     if (!report.suites[row.suite].sizes.empty()) continue;
-    md << "| " << report.suites[row.suite].name << " | " << method_label(row.method) << " | " << row.runs.size() << " | "
-       << number(keypoints(row, report), "%.0f") << " | " << sr_cell(&row) << " | "
+    md << "| " << report.suites[row.suite].name << " | " << method_label(row.method) << " | " << runs_cell(row, report) << " | "
+       << number(keypoints(row, report), "%.0f") << " | " << sr_cell(&row, report) << " | "
        << (is_ours(row.method) && row.method != kOursMatch ? percent(row.success_rate(true)) : "–") << " | "
        << number(median(row.collect([](const Run& r) { return r.coarse.mae_deg; })), "%.2f") << " | "
        << metres(median(row.collect([](const Run& r) { return r.coarse.mte_m; }))) << " | "
@@ -289,7 +304,8 @@ void targets_section(std::ostringstream& md, const Report& report, const std::ve
     if (ours.method != kOursK4pcs && ours.method != kOursMatch) continue;
     const Row* pcl = find_row(rows, ours.suite, ours.points, ours.sigma_m, ours.method == kOursK4pcs ? kPclK4pcs : kPclMatch);
     const Suite& suite = report.suites[ours.suite];
-    const std::string label = suite.name + (ours.points ? " " + size_label(ours.points) : "") + " σ " + sigma_label(ours.sigma_m);
+    const std::string label = suite.name + (ours.points ? " " + size_label(ours.points) : "") + " σ " +
+                              sigma_label(ours.sigma_m) + (partial(ours, report) ? " ‡" : "");
     const double ours_s = median(ours.collect([](const Run& r) { return r.read_s + r.total_s; }));
     double pcl_s = kNan;
     bool lower_bound = false;
@@ -339,7 +355,7 @@ void every_row_table(std::ostringstream& md, const Report& report, const std::ve
     const std::size_t failed = row.count([](const Run& r) { return !r.ok; });
     const std::size_t capped = row.count([](const Run& r) { return r.capped; });
     md << "| " << report.suites[row.suite].name << " | " << size_label(row.points) << " | " << sigma_label(row.sigma_m)
-       << " | " << method_label(row.method) << " | " << row.runs.size() << " | " << failed << " / " << capped << " | "
+       << " | " << method_label(row.method) << " | " << runs_cell(row, report) << " | " << failed << " / " << capped << " | "
        << number(keypoints(row, report), "%.0f") << " | " << percent(row.success_rate(false)) << " | "
        << percent(row.success_rate(true)) << " | "
        << number(median(row.collect([](const Run& r) { return r.coarse.mae_deg; })), "%.2f") << " | "
@@ -433,7 +449,7 @@ void write_runs_csv(const Report& report, const std::string& path) {
 
 void write_rows_csv(const Report& report, const std::vector<Row>& rows, const std::string& path) {
   std::ofstream out(path);
-  out << "suite,points,sigma_m,method,runs,failed,capped,keypoints,sr_coarse,sr_final,mae_deg,mte_m,rmse_coarse_m,"
+  out << "suite,points,sigma_m,method,runs,planned_runs,failed,capped,keypoints,sr_coarse,sr_final,mae_deg,mte_m,rmse_coarse_m,"
          "rmse_final_m,total_median_s,total_min_s,total_max_s,read_median_s";
   const std::vector<std::string> stages = all_stages(report);
   for (const std::string& stage : stages) out << "," << stage << "_median_s";
@@ -441,8 +457,8 @@ void write_rows_csv(const Report& report, const std::vector<Row>& rows, const st
   for (const Row& row : rows) {
     const auto total = row.collect([](const Run& r) { return r.total_s; });
     out << report.suites[row.suite].name << "," << row.points << "," << row.sigma_m << "," << row.method << ","
-        << row.runs.size() << "," << row.count([](const Run& r) { return !r.ok; }) << ","
-        << row.count([](const Run& r) { return r.capped; }) << "," << keypoints(row, report) << ","
+        << row.runs.size() << "," << planned_runs(row, report) << "," << row.count([](const Run& r) { return !r.ok; })
+        << "," << row.count([](const Run& r) { return r.capped; }) << "," << keypoints(row, report) << ","
         << row.success_rate(false) << "," << row.success_rate(true) << ","
         << median(row.collect([](const Run& r) { return r.coarse.mae_deg; })) << ","
         << median(row.collect([](const Run& r) { return r.coarse.mte_m; })) << ","
@@ -542,6 +558,12 @@ std::string markdown(const Report& report, const std::string& results_dir_in_rep
      << ". Command: `"
      << report.command << "`. Raw data: `" << stem << "-runs.csv` (one line per run), `" << stem
      << "-rows.csv` (one line per table row).\n\n";
+  std::size_t planned = 0;
+  for (const auto& [row, count] : report.planned) planned += count;
+  if (report.runs.size() < planned)
+    md << "**In progress:** " << report.runs.size() << " of the " << planned
+       << " runs are in so far (a report from the journal, `--report-only`). Rows marked ‡ are partial: not all "
+          "their pairs and trials have run, so their figures and the targets below are provisional.\n\n";
   configuration_section(md, report);
   targets_section(md, report, rows);
   md << "How the runs are made:\n\n"

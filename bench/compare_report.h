@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <map>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "compare_job.h"
@@ -91,6 +92,9 @@ struct Report {
   std::vector<Case> cases;
   std::vector<KeypointStats> keypoints;  // parallel to cases
   std::vector<Run> runs;
+  // Runs the configuration asks for, per table row (suite, points, sigma_m, method): a report made before
+  // the comparison finished (--report-only) marks its rows partial.
+  std::map<std::tuple<std::size_t, std::size_t, double, std::string>, std::size_t> planned;
 };
 
 // Writes <dir>/compare-<mode>-runs.csv, -rows.csv and the gnuplot scripts -sr-vs-sigma.gp and

@@ -1,5 +1,6 @@
 #include "markdown_block.h"
 
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
@@ -19,6 +20,11 @@ void replace_block(const std::string& file, const std::string& name, const std::
   std::ofstream out(file);
   if (!out) throw std::runtime_error("cannot write " + file);
   out << text;
+}
+
+std::string path_from_markdown(const std::string& markdown_file, const std::string& dir) {
+  namespace fs = std::filesystem;
+  return fs::relative(fs::absolute(dir), fs::absolute(markdown_file).parent_path()).string();
 }
 
 }  // namespace k4reg::bench

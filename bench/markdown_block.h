@@ -11,4 +11,7 @@ namespace k4reg::bench {
 // cannot be written.
 void replace_block(const std::string& file, const std::string& name, const std::string& content);
 
+// How a link in the markdown file reaches dir (both as given on the command line, relative or absolute).
+std::string path_from_markdown(const std::string& markdown_file, const std::string& dir);
+
 }  // namespace k4reg::bench

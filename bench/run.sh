@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# bench/run.sh [--quick] [--table2] [--resume]
+# bench/run.sh [--quick] [--table2] [--resume | --progress]
 # Builds the benchmarks, runs the voxel grid benchmark (Google Benchmark, 5 repetitions, medians), the read
 # throughput of every scan format (k4reg-bench-read, 10 M points, about half a minute) and the K-4PCS / 4PCS
 # comparison with PCL 1.13, then rewrites the machine, voxel, read and compare blocks of bench/RESULTS.md and the
@@ -9,6 +9,8 @@
 #   Without it: the full suites (hours).
 # --resume: continue an interrupted comparison from its journal (bench/results/compare-<mode>-journal.jsonl):
 #   the runs already made are kept, only the missing ones run (same build and options).
+# --progress: while a comparison runs (or after it was interrupted), write its compare block, CSVs and plots
+#   from the journal so far and run nothing; partial rows are marked.
 # --table2: only k4reg-bench-table2: with --quick its 0.7M, sigma = 50 mm row (all 15 pairs x 10 seeds, about
 #   3 min on 2 cores), without it the full grid of 3 sizes x 3 sigmas (about an hour on 2 cores).
 # Not part of the test suite. Build directory: $K4REG_BENCH_BUILD_DIR (default build-bench).
@@ -19,12 +21,14 @@ mode=full
 quick_flag=()
 resume_flag=()
 table2_only=false
+progress=false
 for arg in "$@"; do
   case "$arg" in
     --quick) mode=quick; quick_flag=(--quick) ;;
     --table2) table2_only=true ;;
     --resume) resume_flag=(--resume) ;;
-    *) echo "usage: bench/run.sh [--quick] [--table2] [--resume]" >&2; exit 2 ;;
+    --progress) progress=true ;;
+    *) echo "usage: bench/run.sh [--quick] [--table2] [--resume | --progress]" >&2; exit 2 ;;
   esac
 done
 build=${K4REG_BENCH_BUILD_DIR:-build-bench}
@@ -59,6 +63,22 @@ table2() {
   "$build/bin/k4reg-bench-table2" "${quick_flag[@]}" --cache-dir "$build/bench-cache" --results-dir "$results" \
     --markdown "$markdown" 2>&1 | tee "$results/table2-$mode.log"
 }
+# The comparison's gnuplot scripts carry their data: each writes its PNG next to itself.
+plots() {
+  if command -v gnuplot > /dev/null; then
+    for plot in "$results"/compare-"$mode"-*.gp; do
+      (cd "$results" && gnuplot "$(basename "$plot")")
+    done
+  else
+    echo "gnuplot not found: plots not made" >&2
+  fi
+}
+if $progress; then
+  "$compare" "${quick_flag[@]}" --resume --report-only --cache-dir "$build/bench-cache" --results-dir "$results" \
+    --markdown "$markdown"
+  plots
+  exit 0
+fi
 if $table2_only; then
   table2
   echo "bench/run.sh: done (Table 2, $mode); see $markdown and $results/"
@@ -102,12 +122,6 @@ replace_block "$markdown" read "$read_table"
 "$compare" "${quick_flag[@]}" "${resume_flag[@]}" --cache-dir "$build/bench-cache" --results-dir "$results" \
   --markdown "$markdown" 2>&1 | tee ${resume_flag:+-a} "$results/compare-$mode.log"
 
-if command -v gnuplot > /dev/null; then
-  for plot in "$results"/compare-"$mode"-*.gp; do
-    (cd "$results" && gnuplot "$(basename "$plot")")
-  done
-else
-  echo "gnuplot not found: plots not made" >&2
-fi
+plots
 if [[ $mode == full ]]; then table2; fi
 echo "bench/run.sh: done ($mode); see $markdown and $results/"

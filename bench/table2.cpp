@@ -494,7 +494,7 @@ void run_table2(const Options& o) {
   for (const StationPair& p : pairs) used.insert(p.source), used.insert(p.target);
   fs::create_directories(o.results_dir);
   const std::string rows_csv = o.results_dir + "/table2-rows.csv", runs_csv = o.results_dir + "/table2-runs.csv";
-  const std::string results_in_markdown = fs::relative(o.results_dir, fs::path(o.markdown).parent_path()).string();
+  const std::string results_in_markdown = path_from_markdown(o.markdown, o.results_dir);
 
   const auto start = Clock::now();
   const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
