@@ -11,12 +11,34 @@ set xrange [20:120]
 set yrange [0:105]
 set xtics (25, 50, 100)
 $d0 << EOD
+25 98.6667 
 50 100 
 100 100 
 EOD
 $d1 << EOD
-50 65.7407 
+25 100 
+50 100 
+100 100 
+EOD
+$d2 << EOD
+100 100 
+EOD
+$d3 << EOD
+25 66 
+50 66 
 100 54 
 EOD
+$d4 << EOD
+25 78.6667 
+50 64.6667 
+100 54.6667 
+EOD
+$d5 << EOD
+100 41.1765 
+EOD
 plot $d0 with linespoints lw 2 pt 5 ps 1.5 title 'K-4PCS k4reg 0.7M', \
-     $d1 with linespoints lw 2 pt 7 ps 1.5 title 'K-4PCS PCL 0.7M'
+     $d1 with linespoints lw 2 pt 7 ps 1.5 title 'K-4PCS k4reg 2.5M', \
+     $d2 with linespoints lw 2 pt 9 ps 1.5 title 'K-4PCS k4reg 10.0M', \
+     $d3 with linespoints lw 2 pt 11 ps 1.5 title 'K-4PCS PCL 0.7M', \
+     $d4 with linespoints lw 2 pt 13 ps 1.5 title 'K-4PCS PCL 2.5M', \
+     $d5 with linespoints lw 2 pt 5 ps 1.5 title 'K-4PCS PCL 10.0M'

@@ -11,17 +11,33 @@ set xrange [0.5:14]
 set xtics (0.7, 2.5, 10)
 $d0 << EOD
 0.7 0.496468 0.362682 0.788889 
+2.5 0.691771 0.514124 0.916051 
+10 1.0462 0.91456 1.28551 
 EOD
 $d1 << EOD
-0.7 0.955236 0.766944 1.43088 
+0.7 0.946495 0.766944 1.43088 
+2.5 1.52458 1.02496 2.11613 
 EOD
 $d2 << EOD
-0.7 5.80095 3.57106 14.4035 
+0.7 2.09213 1.54936 2.62122 
+2.5 3.7873 2.91088 5.34477 
 EOD
 $d3 << EOD
-0.7 6.95252 5.75761 12.2272 
+0.7 5.80095 3.57106 14.4035 
+2.5 8.4062 5.08023 30.3158 
+10 9.809 7.47236 10.862 
+EOD
+$d4 << EOD
+0.7 7.34427 5.75761 12.2272 
+2.5 11.2286 7.43875 25.5116 
+EOD
+$d5 << EOD
+0.7 11.9891 9.91559 17.5708 
+2.5 25.1434 19.6323 42.0291 
 EOD
 plot $d0 with yerrorlines lw 2 pt 5 ps 1.5 title 'K-4PCS k4reg σ 100 mm', \
      $d1 with yerrorlines lw 2 pt 7 ps 1.5 title 'K-4PCS k4reg σ 50 mm', \
-     $d2 with yerrorlines lw 2 pt 9 ps 1.5 title 'K-4PCS PCL σ 100 mm', \
-     $d3 with yerrorlines lw 2 pt 11 ps 1.5 title 'K-4PCS PCL σ 50 mm'
+     $d2 with yerrorlines lw 2 pt 9 ps 1.5 title 'K-4PCS k4reg σ 25 mm', \
+     $d3 with yerrorlines lw 2 pt 11 ps 1.5 title 'K-4PCS PCL σ 100 mm', \
+     $d4 with yerrorlines lw 2 pt 13 ps 1.5 title 'K-4PCS PCL σ 50 mm', \
+     $d5 with yerrorlines lw 2 pt 5 ps 1.5 title 'K-4PCS PCL σ 25 mm'
