@@ -34,7 +34,7 @@ $d4 << EOD
 100 54.6667 
 EOD
 $d5 << EOD
-100 41.1765 
+100 59.322 
 EOD
 plot $d0 with linespoints lw 2 pt 5 ps 1.5 title 'K-4PCS k4reg 0.7M', \
      $d1 with linespoints lw 2 pt 7 ps 1.5 title 'K-4PCS k4reg 2.5M', \
