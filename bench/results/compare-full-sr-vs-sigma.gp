@@ -21,6 +21,8 @@ $d1 << EOD
 100 100 
 EOD
 $d2 << EOD
+25 100 
+50 100 
 100 100 
 EOD
 $d3 << EOD
@@ -34,7 +36,9 @@ $d4 << EOD
 100 54.6667 
 EOD
 $d5 << EOD
-100 59.322 
+25 78.6667 
+50 68 
+100 54 
 EOD
 plot $d0 with linespoints lw 2 pt 5 ps 1.5 title 'K-4PCS k4reg 0.7M', \
      $d1 with linespoints lw 2 pt 7 ps 1.5 title 'K-4PCS k4reg 2.5M', \
