@@ -338,7 +338,9 @@ void targets_section(std::ostringstream& md, const Report& report, const std::ve
   }
   md << "- End to end at least 10× faster than PCL K-4PCS, median over the rows: **" << fmt("%.1f×", median_ratio)
      << " – " << (median_ratio >= 10.0 ? "met" : "not met") << "**"
-     << (lower_bounds ? " (" + std::to_string(lower_bounds) + " rows count PCL at its cap: lower bounds)" : "") << ".\n";
+     << (lower_bounds ? " (" + std::to_string(lower_bounds) + (lower_bounds == 1 ? " row counts" : " rows count") +
+                            " PCL at its cap: lower bounds)"
+                      : "") << ".\n";
   if (!ten_million.empty())
     md << "- Two 10 M-point scans under 15 s and 3 GB (k4reg end to end, median; largest peak RSS): " << ten_million
        << "\n";
