@@ -67,8 +67,12 @@ RegistrationResult result_from_proto(const v1::RegistrationResult& m) {
   r.target_keypoints = m.target_keypoints();
   r.signal = m.signal();
   r.ambiguity_margin = m.ambiguity_margin();
+  r.ambiguous = m.ambiguous();
+  r.ambiguity_reason = m.ambiguity_reason();
+  r.min_scale_m_used = m.min_scale_m_used();
+  r.overlap_used = m.overlap_used();
   for (const v1::Hypothesis& h : m.hypotheses())
-    r.hypotheses.push_back({matrix_from_proto(h.transform()), h.keypoint_score(), h.cloud_score()});
+    r.hypotheses.push_back({matrix_from_proto(h.transform()), h.keypoint_score(), h.cloud_score(), h.refined_score()});
   r.bases_tried = m.bases_tried();
   r.seed = m.seed();
   r.icp_converged = m.icp_converged();

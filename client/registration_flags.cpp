@@ -7,11 +7,15 @@ namespace k4reg::cli {
 RegistrationFlags add_registration_flags(CLI::App& command, RegistrationParams& params) {
   RegistrationFlags flags{};
   flags.min_scale =
-      command.add_option("--min-scale", params.min_scale_m, "minimum DoG scale sigma and voxel spacing, metres")
-          ->capture_default_str()
+      command
+          .add_option("--min-scale", params.min_scale_m,
+                      "minimum DoG scale sigma and voxel spacing, in the files' units (default: from the scans' "
+                      "sampling; halved while a scale finds too few keypoints or no well-supported pose)")
           ->check(CLI::Range(0.001, 10.0));
-  flags.overlap = command.add_option("--overlap", params.overlap, "approximate overlap of the two scans, (0, 1]")
-                      ->capture_default_str()
+  flags.overlap = command
+                      .add_option("--overlap", params.overlap,
+                                  "approximate overlap of the two scans, [0.05, 1] (default: automatic, bases for "
+                                  "0.8, then 0.6, then 0.4 until a pose is well supported)")
                       ->check(CLI::Range(0.05, 1.0));
   flags.no_icp = command.add_flag("--no-icp{false}", params.icp, "skip the ICP refinement (coarse K-4PCS result only)");
   flags.seed = command.add_option("--seed", params.seed, "random seed; the same seed gives the same result")

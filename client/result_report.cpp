@@ -30,6 +30,10 @@ nlohmann::json result_to_json(const RegistrationResult& r) {
   j["target_keypoints"] = r.target_keypoints;
   j["signal"] = r.signal;
   j["ambiguity_margin"] = r.ambiguity_margin;
+  j["ambiguous"] = r.ambiguous;
+  j["ambiguity_reason"] = r.ambiguity_reason;
+  j["min_scale_m_used"] = r.min_scale_m_used;
+  j["overlap_used"] = r.overlap_used;
   j["bases_tried"] = r.bases_tried;
   j["seed"] = r.seed;
   j["icp_converged"] = r.icp_converged;
@@ -37,7 +41,10 @@ nlohmann::json result_to_json(const RegistrationResult& r) {
   j["hypotheses"] = nlohmann::json::array();
   for (const Hypothesis& h : r.hypotheses)
     j["hypotheses"].push_back(
-        {{"transform", matrix_to_json(h.transform)}, {"keypoint_score", h.keypoint_score}, {"cloud_score", h.cloud_score}});
+        {{"transform", matrix_to_json(h.transform)},
+         {"keypoint_score", h.keypoint_score},
+         {"cloud_score", h.cloud_score},
+         {"refined_score", h.refined_score}});
   j["timings"] = nlohmann::json::array();
   for (const StageTiming& t : r.timings) j["timings"].push_back({{"stage", t.stage}, {"seconds", t.seconds}});
   return j;
@@ -50,12 +57,17 @@ void print_result_table(std::ostream& out, const RegistrationResult& r) {
   out << fmt::format("{:<22}{}\n", "inliers", r.inliers);
   out << fmt::format("{:<22}{} / {}\n", "points", r.source_points, r.target_points);
   out << fmt::format("{:<22}{} / {} ({})\n", "keypoints", r.source_keypoints, r.target_keypoints, r.signal);
-  out << fmt::format("{:<22}{:.3f}{}\n", "ambiguity margin", r.ambiguity_margin,
-                     r.ambiguity_margin < 0.05 ? "  (ambiguous: check the runner-up hypotheses)" : "");
+  out << fmt::format("{:<22}{:.4g} m\n", "min scale used", r.min_scale_m_used);
+  out << fmt::format("{:<22}{:.2f}\n", "overlap used", r.overlap_used);
+  out << fmt::format("{:<22}{:.3f}\n", "ambiguity margin", r.ambiguity_margin);
+  out << fmt::format("{:<22}{}\n", "ambiguous", r.ambiguous ? "yes: " + r.ambiguity_reason : "no");
   out << fmt::format("{:<22}{}\n", "hypotheses", r.hypotheses.size());
-  for (std::size_t k = 0; k < r.hypotheses.size(); ++k)
-    out << fmt::format("  #{}  cloud score {:.3f}  keypoint score {:.3f}\n", k + 1, r.hypotheses[k].cloud_score,
-                       r.hypotheses[k].keypoint_score);
+  for (std::size_t k = 0; k < r.hypotheses.size(); ++k) {
+    const Hypothesis& h = r.hypotheses[k];
+    out << fmt::format("  #{}  cloud score {:.3f}  keypoint score {:.3f}", k + 1, h.cloud_score, h.keypoint_score);
+    if (h.refined_score > 0) out << fmt::format("  refined score {:.3f}", h.refined_score);
+    out << "\n";
+  }
   out << fmt::format("{:<22}{}\n", "seed", r.seed);
   double total = 0;
   for (const StageTiming& t : r.timings) {

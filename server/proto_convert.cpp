@@ -104,12 +104,17 @@ void result_to_proto(const RegistrationResult& r, v1::RegistrationResult* m) {
   m->set_target_keypoints(r.target_keypoints);
   m->set_signal(r.signal);
   m->set_ambiguity_margin(r.ambiguity_margin);
+  m->set_ambiguous(r.ambiguous);
+  m->set_ambiguity_reason(r.ambiguity_reason);
+  m->set_min_scale_m_used(r.min_scale_m_used);
+  m->set_overlap_used(r.overlap_used);
   m->clear_hypotheses();
   for (const Hypothesis& h : r.hypotheses) {
     v1::Hypothesis* out = m->add_hypotheses();
     matrix_to_proto(h.transform, out->mutable_transform());
     out->set_keypoint_score(h.keypoint_score);
     out->set_cloud_score(h.cloud_score);
+    out->set_refined_score(h.refined_score);
   }
   m->set_bases_tried(r.bases_tried);
   m->set_seed(r.seed);

@@ -12,6 +12,7 @@
 #include "k4reg/metrics.h"
 #include "k4reg/neighbor_grid.h"
 #include "k4reg/rigid_fit.h"
+#include "k4reg/sampling.h"
 
 namespace k4reg {
 namespace {
@@ -21,21 +22,6 @@ constexpr int kPrescreenPoints[] = {20, 40, 200};  // cheap looks before a full 
 constexpr std::size_t kMaxSetsPerBase = 20000;     // verified per base (an even subsample)
 constexpr std::size_t kMaxSetsFound = 8 * kMaxSetsPerBase;  // collected per base: bounds memory and time
 constexpr double kInlierFactor = 3.0;   // inlier distance in units of delta
-
-// Robust extent of a cloud: the diagonal of the 2nd..98th percentile box, blind to a few far outliers.
-double robust_diameter(const std::vector<Eigen::Vector3f>& points) {
-  Eigen::Vector3d extent;
-  for (int axis = 0; axis < 3; ++axis) {
-    std::vector<float> v(points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) v[i] = points[i][axis];
-    const std::size_t lo = v.size() / 50, hi = v.size() - 1 - v.size() / 50;
-    std::nth_element(v.begin(), v.begin() + lo, v.end());
-    const float low = v[lo];
-    std::nth_element(v.begin(), v.begin() + hi, v.end());
-    extent[axis] = v[hi] - low;
-  }
-  return extent.norm();
-}
 
 // MSAC-style score: each point contributes 1 - d^2/tau^2 when within tau of a target point. (Free space
 // is left to the symmetry guard, which scores whole clouds; keypoints are too few to profit from it.)

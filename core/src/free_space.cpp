@@ -31,6 +31,23 @@ FreeSpaceImage::FreeSpaceImage(const std::vector<Eigen::Vector3f>& points, const
     float& nearest = nearest_[cell(d / range)];
     nearest = std::min(nearest, range);
   }
+  // Each cell takes the nearest return of its 3 x 3 neighbourhood. A cell's few returns may all lie at
+  // its far side: on a surface seen at grazing incidence the range changes by metres across one cell,
+  // and a point at the near side would count as seen through. Only what is nearer than every return
+  // around it is contradicted.
+  std::vector<float> own = nearest_;
+  for (int e = 0; e < elevation_cells_; ++e)
+    for (int a = 0; a < azimuth_cells_; ++a) {
+      float& nearest = nearest_[static_cast<std::size_t>(e) * azimuth_cells_ + a];
+      for (int de = -1; de <= 1; ++de) {
+        const int ee = e + de;
+        if (ee < 0 || ee >= elevation_cells_) continue;
+        for (int da = -1; da <= 1; ++da) {
+          const int aa = (a + da + azimuth_cells_) % azimuth_cells_;  // azimuth wraps around
+          nearest = std::min(nearest, own[static_cast<std::size_t>(ee) * azimuth_cells_ + aa]);
+        }
+      }
+    }
 }
 
 int FreeSpaceImage::cell(const Eigen::Vector3f& u) const {

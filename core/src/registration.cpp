@@ -1,12 +1,14 @@
 #include "k4reg/registration.h"
 
 #include <Eigen/Eigenvalues>
+#include <fmt/format.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <optional>
 
 #include "k4reg/dog_keypoints.h"
@@ -15,7 +17,9 @@
 #include "k4reg/free_space.h"
 #include "k4reg/icp.h"
 #include "k4reg/neighbor_grid.h"
+#include "k4reg/pose_score.h"
 #include "k4reg/rigid_fit.h"
+#include "k4reg/sampling.h"
 #include "k4reg/surface_signal.h"
 #include "k4reg/symmetry_guard.h"
 #include "k4reg/voxel_grid.h"
@@ -54,8 +58,9 @@ class StageTimer {
 
 void validate(const RegistrationParams& p) {
   auto bad = [](const std::string& what) { fail(ErrorCode::kInvalidArgument, what); };
-  if (!(p.min_scale_m >= 0.001 && p.min_scale_m <= 10.0)) bad("min_scale_m must be in [0.001, 10] m");
-  if (!(p.overlap >= 0.05 && p.overlap <= 1.0)) bad("overlap must be in [0.05, 1]");
+  if (!(p.min_scale_m == 0.0 || (p.min_scale_m >= 0.001 && p.min_scale_m <= 10.0)))
+    bad("min_scale_m must be 0 (automatic) or in [0.001, 10] m");
+  if (!(p.overlap == 0.0 || (p.overlap >= 0.05 && p.overlap <= 1.0))) bad("overlap must be 0 (automatic) or in [0.05, 1]");
   if (p.octaves < 1 || p.octaves > 8) bad("octaves must be in [1, 8]");
   if (p.scales_per_octave < 1 || p.scales_per_octave > 10) bad("scales_per_octave must be in [1, 10]");
   if (!(p.min_contrast >= 0.0 && p.min_contrast < 1.0)) bad("min_contrast must be in [0, 1)");
@@ -123,13 +128,21 @@ double spacing_for_count(const PointCloud& voxels, double start_m, std::size_t p
   return spacing;
 }
 
-// The outcome of steps 2-4 for one keypoint signal.
+// The outcome of steps 2-4 for one keypoint signal and one round of bases.
 struct CoarseAlignment {
   std::string signal;
   std::size_t source_keypoints = 0, target_keypoints = 0;
   int bases_tried = 0;
+  double overlap = 0.0;  // whose bases found it
   SymmetryGuardResult guarded;
   const Hypothesis& best() const { return guarded.hypotheses.front(); }
+};
+
+// The point sets 4PCS runs on, per keypoint signal (computed once, used by every round of bases).
+struct PointSets {
+  std::string signal;
+  std::vector<Eigen::Vector3f> source, target;
+  std::vector<std::uint8_t> source_labels, target_labels;  // DoG extremum: 1 maximum, 0 minimum
 };
 
 // Source -> target in the files' frames from the transform between the local (origin-shifted) frames.
@@ -140,14 +153,36 @@ Eigen::Matrix4d to_file_frames(const Eigen::Matrix4d& local, const Eigen::Vector
   return t;
 }
 
-RegistrationResult run(const PointCloud& source, const PointCloud& target, const RegistrationParams& params,
-                       const CancellationToken* cancel, const ProgressCallback& progress) {
+// Cloud scores of true poses: lab ~0.95, outdoor ~0.85 (free space counts unseen points neither way);
+// without free space (objects) about the overlap itself.
+constexpr double kSignalFallback = 0.6;  // an intensity pose below this meets the geometric signal's best
+// A pose is well supported, and the search for more stops, at min(0.6, 0.75 x overlap).
+double well_supported(double overlap) { return std::min(kSignalFallback, 0.75 * overlap); }
+
+// The automatic overlap: rounds of fresh bases, each for a smaller overlap (more and narrower bases),
+// while no pose is well supported.
+constexpr double kAutoOverlaps[] = {0.8, 0.6, 0.4};
+
+// Hypotheses whose cloud score is within this share of the best are refined fully and judged again.
+constexpr double kContenderBand = 0.2;
+constexpr std::size_t kMaxContenders = 3;
+
+// The single-scale pipeline's outcome: the result, and whether its pose is well supported.
+struct ScaleAttempt {
+  RegistrationResult result;
+  bool supported = false;
+};
+
+// The single-scale pipeline, steps 1-5, at minimum scale sigma.
+ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& target,
+                                     const RegistrationParams& params, double sigma, const CancellationToken* cancel,
+                                     const ProgressCallback& progress) {
   RegistrationResult result;
   result.seed = params.seed;
   result.source_points = source.size();
   result.target_points = target.size();
+  result.min_scale_m_used = sigma;
   StageTimer timer(result, progress);
-  const double sigma = params.min_scale_m;
 
   // 1. Voxel grid at the minimum scale (paper Sec. 2.1).
   // Named references rather than structured bindings: lambdas below use them, and clang < 16 cannot capture
@@ -187,48 +222,57 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
     free_space.emplace(target.points, scanner_position(target), 3.0 * delta);  // raw points fill every cell
   const ScanViews views{free_space ? &*free_space : nullptr, scanner_position(source), scanner_position(target)};
 
-  // 2-4. Coarse alignment on one keypoint signal: the point sets, 4PCS, the symmetry guard.
-  auto coarse = [&](KeypointSignal signal) {
-    CoarseAlignment out;
-    // 2. The point sets 4PCS runs on: DoG keypoints (K-4PCS) or a coarser voxel grid (plain 4PCS).
-    std::vector<Eigen::Vector3f> source_set, target_set;
-    std::vector<std::uint8_t> source_labels, target_labels;  // DoG extremum: 1 maximum, 0 minimum
+  // 2. The point sets 4PCS runs on: DoG keypoints (K-4PCS) or a coarser voxel grid (plain 4PCS).
+  std::vector<PointSets> point_sets;  // one per signal asked for so far
+  auto sets_for = [&](KeypointSignal signal) -> const PointSets& {
+    const bool intensity = source.has_intensity() && target.has_intensity();
+    for (const PointSets& sets : point_sets)
+      if (sets.signal == (plain ? "voxels" : surface_signal_name(signal, intensity))) return sets;
+    PointSets& sets = point_sets.emplace_back();
     if (!plain) {
       timer.run("keypoints", [&] {
-        const bool intensity = source.has_intensity() && target.has_intensity();
         DogParams dog{sigma, params.octaves, params.scales_per_octave, params.min_contrast};
         for (const auto* voxels : {&source_voxels, &target_voxels}) {
           const SurfaceSignal surface = make_surface_signal(voxels->cloud, sigma, signal, intensity, cancel);
-          out.signal = surface.name;
+          sets.signal = surface.name;
           const bool is_source = voxels == &source_voxels;
           DogKeypoints keypoints = detect_dog_keypoints(voxels->cloud.points, surface.values, dog, cancel);
-          auto& labels = is_source ? source_labels : target_labels;
+          auto& labels = is_source ? sets.source_labels : sets.target_labels;
           for (const float response : keypoints.response) labels.push_back(response > 0.0f);
-          (is_source ? source_set : target_set) = std::move(keypoints.points);
+          (is_source ? sets.source : sets.target) = std::move(keypoints.points);
         }
         return 0;
       });
-      constexpr std::size_t kMinKeypoints = 8;
-      if (source_set.size() < kMinKeypoints || target_set.size() < kMinKeypoints)
-        fail(ErrorCode::kFailedPrecondition,
-             "too few keypoints (source " + std::to_string(source_set.size()) + ", target " +
-                 std::to_string(target_set.size()) + "): try a smaller min_scale_m or check the clouds");
     } else {
       timer.run("plain_grid", [&] {
-        source_set = voxel_grid(source_voxels.cloud, delta, cancel).cloud.points;
-        target_set = voxel_grid(target_voxels.cloud, delta, cancel).cloud.points;
+        sets.source = voxel_grid(source_voxels.cloud, delta, cancel).cloud.points;
+        sets.target = voxel_grid(target_voxels.cloud, delta, cancel).cloud.points;
         return 0;
       });
-      out.signal = "voxels";
+      sets.signal = "voxels";
     }
-    out.source_keypoints = source_set.size();
-    out.target_keypoints = target_set.size();
+    return sets;
+  };
+
+  // 2-4. Coarse alignment on one signal with one round of bases: 4PCS, then the symmetry guard.
+  auto coarse = [&](KeypointSignal signal, double overlap, std::uint64_t seed) {
+    const PointSets& sets = sets_for(signal);
+    constexpr std::size_t kMinKeypoints = 8;
+    if (!plain && (sets.source.size() < kMinKeypoints || sets.target.size() < kMinKeypoints))
+      fail(ErrorCode::kFailedPrecondition,
+           "too few keypoints (source " + std::to_string(sets.source.size()) + ", target " +
+               std::to_string(sets.target.size()) + ")");
+    CoarseAlignment out;
+    out.signal = sets.signal;
+    out.source_keypoints = sets.source.size();
+    out.target_keypoints = sets.target.size();
+    out.overlap = overlap;
 
     // 3. 4PCS on the two point sets (paper Sec. 2.2).
     const FourPcsResult matched = timer.run("matching", [&] {
-      FourPcsParams four{delta, params.overlap, params.max_bases, params.hypotheses_kept, params.seed};
-      if (!plain) four.source_labels = &source_labels, four.target_labels = &target_labels;
-      return match_4pcs(source_set, target_set, four, cancel, progress);
+      FourPcsParams four{delta, overlap, params.max_bases, params.hypotheses_kept, seed};
+      if (!plain) four.source_labels = &sets.source_labels, four.target_labels = &sets.target_labels;
+      return match_4pcs(sets.source, sets.target, four, cancel, progress);
     });
     out.bases_tried = matched.bases_tried;
 
@@ -236,8 +280,7 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
     //    voxelised clouds, where the furniture that breaks a room's symmetry is visible.
     const auto& icp = icp_pyramids();
     out.guarded = timer.run("symmetry_guard", [&] {
-      return rank_hypotheses(icp.first, icp.second, matched.hypotheses, params.overlap, free_space ? &views : nullptr,
-                             cancel);
+      return rank_hypotheses(icp.first, icp.second, matched.hypotheses, overlap, free_space ? &views : nullptr, cancel);
     });
     return out;
   };
@@ -246,43 +289,193 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
   // returns at grazing incidence outdoors, or a constant intensity field), the best pose it finds
   // explains the clouds poorly or none is found at all; then the geometric signal gets its turn, and
   // the pose the clouds support better stands (the cloud score does not depend on the signal).
-  constexpr double kWellSupported = 0.6;  // cloud score of true poses: lab ~0.95, outdoor ~0.85
-  std::optional<CoarseAlignment> chosen;
+  // With the overlap left automatic, rounds of fresh bases follow while no pose is well supported.
   const bool may_fall_back =
       !plain && params.signal == KeypointSignal::kAuto && source.has_intensity() && target.has_intensity();
-  try {
-    chosen = coarse(params.signal);
-  } catch (const Error& e) {
-    if (!may_fall_back || e.code() != ErrorCode::kFailedPrecondition) throw;
+  std::vector<double> overlaps{params.overlap};
+  if (params.overlap == 0.0) overlaps.assign(std::begin(kAutoOverlaps), std::end(kAutoOverlaps));
+  std::optional<CoarseAlignment> chosen;
+  std::optional<Error> failure;
+  int bases = 0;
+  std::size_t rounds_run = 0;
+  for (std::size_t round = 0; round < overlaps.size(); ++round) {
+    ++rounds_run;
+    // Round 0 keeps the caller's seed; later rounds draw fresh bases.
+    const std::uint64_t seed = params.seed + 0x9E3779B97F4A7C15ULL * round;
+    auto attempt = [&](KeypointSignal signal) {
+      try {
+        CoarseAlignment candidate = coarse(signal, overlaps[round], seed);
+        bases += candidate.bases_tried;
+        if (!chosen || candidate.best().cloud_score > chosen->best().cloud_score) chosen = std::move(candidate);
+      } catch (const Error& e) {
+        if (e.code() != ErrorCode::kFailedPrecondition) throw;
+        if (!failure) failure = e;
+      }
+    };
+    attempt(params.signal);
+    if (may_fall_back && (!chosen || chosen->best().cloud_score < kSignalFallback)) attempt(KeypointSignal::kGeometric);
+    if (chosen && chosen->best().cloud_score >= well_supported(overlaps[round])) break;
   }
-  if (may_fall_back && (!chosen || chosen->best().cloud_score < kWellSupported)) {
-    CoarseAlignment geometric = coarse(KeypointSignal::kGeometric);
-    if (!chosen || geometric.best().cloud_score > chosen->best().cloud_score) chosen = std::move(geometric);
-  }
+  if (!chosen) throw *failure;
   result.signal = chosen->signal;
   result.source_keypoints = chosen->source_keypoints;
   result.target_keypoints = chosen->target_keypoints;
-  result.bases_tried = chosen->bases_tried;
+  result.bases_tried = bases;
+  result.overlap_used = chosen->overlap;
   result.hypotheses = chosen->guarded.hypotheses;
   result.ambiguity_margin = chosen->guarded.ambiguity_margin;
-  const Hypothesis& best = result.hypotheses.front();
 
-  // 5. ICP refinement on the voxelised clouds (or just the quality figures with --no-icp).
-  const IcpResult refined = timer.run("icp", [&] {
-    IcpParams final_params = icp_params;
-    if (!params.icp) final_params.max_iterations = 0;  // quality figures only, at the finest stage
-    return refine_icp(icp_pyramids().first, icp_pyramids().second, best.transform, final_params, cancel);
+  // 5. ICP refinement on the voxelised clouds (or just the quality figures with --no-icp). Where
+  //    runner-ups come close, each is refined fully and judged on what symmetry does not copy; every
+  //    refined pose is scored again (pose_score.h).
+  const auto& icp = icp_pyramids();
+  IcpParams final_params = icp_params;
+  if (!params.icp) final_params.max_iterations = 0;  // quality figures only, at the finest stage
+  std::size_t contenders = 1;
+  while (contenders < std::min(kMaxContenders, result.hypotheses.size()) &&
+         result.hypotheses[contenders].cloud_score >= (1.0 - kContenderBand) * result.hypotheses.front().cloud_score)
+    ++contenders;
+  std::vector<IcpResult> refined(contenders);
+  timer.run("icp", [&] {
+    for (std::size_t i = 0; i < contenders; ++i)
+      refined[i] = refine_icp(icp.first, icp.second, result.hypotheses[i].transform, final_params, cancel);
+    return 0;
   });
-  const Eigen::Matrix4d local = params.icp ? refined.transform : best.transform;
-  result.icp_converged = params.icp && refined.converged;
-  result.icp_iterations = params.icp ? refined.iterations : 0;
-  result.rmse_m = refined.rmse_m;
-  result.overlap = refined.overlap;
-  result.inliers = refined.inliers;
+  // Per contender: the share of the source the target explains once refined. Contenders that refined into
+  // an earlier one's pose drop out.
+  const PoseScorer scorer(icp.first, icp.second, free_space ? &views : nullptr, result.overlap_used);
+  std::vector<double> refined_scores;
+  std::vector<std::size_t> kept;
+  timer.run("verdict", [&] {
+    for (std::size_t i = 0; i < contenders; ++i) {
+      Hypothesis& h = result.hypotheses[i];
+      if (params.icp) h.transform = refined[i].transform;
+      if (std::any_of(kept.begin(), kept.end(), [&](std::size_t k) {
+            return !distinct_transforms(result.hypotheses[k].transform, h.transform, 2.0, 2.0 * sigma);
+          }))
+        continue;
+      h.refined_score = scorer.score(h.transform);
+      kept.push_back(i);
+      refined_scores.push_back(h.refined_score);
+    }
+    return 0;
+  });
+  std::vector<std::size_t> order(kept.size());  // positions in kept, best first
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return refined_scores[a] > refined_scores[b]; });
+  const std::size_t winner = kept[order[0]];
+  if (kept.size() > 1)
+    result.ambiguity_margin =
+        refined_scores[order[0]] > 0 ? std::clamp((refined_scores[order[0]] - refined_scores[order[1]]) / refined_scores[order[0]], 0.0, 1.0) : 0.0;
+  else if (contenders > 1)  // the runner-ups refined into the winner: the next hypothesis is the runner-up
+    result.ambiguity_margin =
+        contenders < result.hypotheses.size()
+            ? std::clamp(1.0 - result.hypotheses[contenders].cloud_score / result.hypotheses[winner].cloud_score, 0.0, 1.0)
+            : 1.0;
+  // The winner first, the other contenders after it, the rest as they were.
+  std::vector<Hypothesis> reordered;
+  for (std::size_t i : order) reordered.push_back(result.hypotheses[kept[i]]);
+  reordered.insert(reordered.end(), result.hypotheses.begin() + contenders, result.hypotheses.end());
+  result.hypotheses = std::move(reordered);
+  const IcpResult& final_icp = refined[winner];
+  const Hypothesis& best = result.hypotheses.front();
+  const Eigen::Matrix4d local = params.icp ? final_icp.transform : best.transform;
+  result.icp_converged = params.icp && final_icp.converged;
+  result.icp_iterations = params.icp ? final_icp.iterations : 0;
+  result.rmse_m = final_icp.rmse_m;
+  result.overlap = final_icp.overlap;
+  result.inliers = final_icp.inliers;
+
+  // The smallest overlap searched sets what a true pose must explain.
+  const double needed = well_supported(overlaps[std::min(rounds_run, overlaps.size()) - 1]);
+  if (best.refined_score < needed) {
+    result.ambiguous = true;
+    result.ambiguity_reason = fmt::format(
+        "poorly supported: the best pose explains {:.0f} % of the source once refined (true poses: {:.0f} % or more)",
+        100 * best.refined_score, 100 * needed);
+  } else if (result.hypotheses.size() >= 2 && result.ambiguity_margin < kAmbiguousMargin) {
+    result.ambiguous = true;
+    result.ambiguity_reason = fmt::format(
+        "a runner-up pose is nearly as well supported (margin {:.3f} < {}): the scene may be symmetric; see the hypotheses",
+        result.ambiguity_margin, kAmbiguousMargin);
+  }
 
   result.transform = to_file_frames(local, source.origin_m, target.origin_m);
   for (Hypothesis& h : result.hypotheses) h.transform = to_file_frames(h.transform, source.origin_m, target.origin_m);
-  return result;
+  return {std::move(result), best.refined_score >= needed};
+}
+
+// The scales to try, coarsest first: the caller's or the automatic start, halved while a scale finds
+// too few keypoints or no well-supported pose, down to the point spacing.
+class ScaleLadder {
+ public:
+  ScaleLadder(const PointCloud& source, const PointCloud& target, double min_scale_m)
+      : source_(source), target_(target), start_m_(min_scale_m) {
+    if (start_m_ == 0.0) {
+      const Sampling s = measure_sampling(source), t = measure_sampling(target);
+      spacing_m_ = std::max(s.spacing_m, t.spacing_m);
+      start_m_ = std::max(std::min(s.diameter_m, t.diameter_m) / kDiameterPerScale, 2.0 * spacing_m_);
+      if (!(start_m_ > 0.0))
+        fail(ErrorCode::kInvalidArgument, "the clouds have no extent: all points coincide");
+    }
+  }
+  double start_m() const { return start_m_; }
+  // The scale after `scale_m`, or 0 when none is left.
+  double next(double scale_m, int tried) {
+    if (tried >= kMaxScales) return 0.0;
+    if (spacing_m_ < 0) spacing_m_ = std::max(measure_sampling(source_).spacing_m, measure_sampling(target_).spacing_m);
+    return 0.5 * scale_m >= spacing_m_ ? 0.5 * scale_m : 0.0;
+  }
+
+ private:
+  // DoG scales run from sigma to 2^5 sigma: at diameter / 128 the coarsest octave still sees a quarter
+  // of the scene, so a scan of any size and unit yields keypoints at every octave.
+  static constexpr double kDiameterPerScale = 128.0;
+  static constexpr int kMaxScales = 4;
+  const PointCloud& source_;
+  const PointCloud& target_;
+  double start_m_;
+  double spacing_m_ = -1.0;  // measured when first needed
+};
+
+// Stage timings of two attempts added up, stage by stage.
+void add_timings(std::vector<StageTiming>& total, const std::vector<StageTiming>& more) {
+  for (const StageTiming& t : more) {
+    auto same = std::find_if(total.begin(), total.end(), [&](const StageTiming& s) { return s.stage == t.stage; });
+    if (same != total.end())
+      same->seconds += t.seconds;
+    else
+      total.push_back(t);
+  }
+}
+
+RegistrationResult run(const PointCloud& source, const PointCloud& target, const RegistrationParams& params,
+                       const CancellationToken* cancel, const ProgressCallback& progress) {
+  ScaleLadder ladder(source, target, params.min_scale_m);
+  std::optional<RegistrationResult> best;
+  std::optional<Error> failure;
+  std::vector<StageTiming> timings;
+  int tried = 0;
+  for (double sigma = ladder.start_m(); sigma > 0.0; sigma = ladder.next(sigma, tried)) {
+    ++tried;
+    try {
+      ScaleAttempt attempt = register_at_scale(source, target, params, sigma, cancel, progress);
+      add_timings(timings, attempt.result.timings);
+      const double support = attempt.result.hypotheses.front().refined_score;
+      const bool supported = attempt.supported;
+      if (!best || support > best->hypotheses.front().refined_score) best = std::move(attempt.result);
+      if (supported) break;
+    } catch (const Error& e) {
+      if (e.code() != ErrorCode::kFailedPrecondition) throw;
+      if (!failure) failure = e;
+    }
+  }
+  if (!best)
+    fail(ErrorCode::kFailedPrecondition,
+         std::string(failure->what()) + " at every scale tried from " + std::to_string(ladder.start_m()) +
+             " m down to the point spacing: check that the clouds overlap");
+  best->timings = std::move(timings);
+  return std::move(*best);
 }
 
 }  // namespace

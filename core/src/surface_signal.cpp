@@ -40,10 +40,14 @@ std::vector<float> surface_variation(const std::vector<Eigen::Vector3f>& points,
   return variation;
 }
 
+std::string surface_signal_name(KeypointSignal requested, bool use_intensity) {
+  const bool intensity = requested == KeypointSignal::kIntensity || (requested == KeypointSignal::kAuto && use_intensity);
+  return intensity ? "intensity" : "geometric";
+}
+
 SurfaceSignal make_surface_signal(const PointCloud& voxels, double voxel_m, KeypointSignal requested, bool use_intensity,
                                   const CancellationToken* cancel) {
-  const bool intensity = requested == KeypointSignal::kIntensity || (requested == KeypointSignal::kAuto && use_intensity);
-  if (intensity) {
+  if (surface_signal_name(requested, use_intensity) == "intensity") {
     if (!voxels.has_intensity()) fail(ErrorCode::kInvalidArgument, "intensity signal requested but a cloud has no intensity");
     // Intensity is reflectance times an incidence and range falloff that differ between stations. In
     // log space those smooth factors become additive and the DoG (a band-pass) cancels them.

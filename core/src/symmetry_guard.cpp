@@ -27,56 +27,6 @@ bool seen_from_the_same_side(const Eigen::Vector3f& n, const Eigen::Vector3f& vi
   return a * b >= 0.0f || std::abs(a) < kGrazingCos * view_a.norm() || std::abs(b) < kGrazingCos * view_b.norm();
 }
 
-// Without views: the share of source points with a target point within tau. With the target's free
-// space, a point is also consistent where it lies at the target scanner's first return in its
-// direction (sparse far surfaces have gaps wider than tau), contradicted where the target scanner saw
-// through it, and no evidence either way where that scanner could not see it (behind its first return,
-// or no return) or where the two scanners saw its surface from opposite sides. Counting unseen points
-// as misses favours the pose that maps one scanner's occlusion shadows onto the other's — in a
-// symmetric room, the flip. So the score is, of the points with evidence, the share consistent less
-// the share contradicted.
-double cloud_score(const std::vector<Eigen::Vector3f>& source, const IcpPyramid::Stage& reference,
-                   const NeighborGrid& grid, float tau, const Eigen::Matrix4d& t, const ScanViews* views,
-                   double overlap) {
-  const Eigen::Affine3f a = to_affine3f(t);
-  const Eigen::Vector3f source_scanner = views ? Eigen::Vector3f(a * views->source_scanner_m) : Eigen::Vector3f::Zero();
-  struct Counts {
-    std::size_t consistent = 0, contradicted = 0, unseen = 0;
-  };
-  // Integer counts: the same for any split over threads.
-  const Counts counts = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, source.size(), 4096), Counts{},
-      [&](const tbb::blocked_range<std::size_t>& range, Counts c) {
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          const Eigen::Vector3f q = a * source[i];
-          const int k = grid.nearest_within(q, tau);
-          if (k >= 0) {
-            const bool same_side = !views || seen_from_the_same_side(reference.normals[k], q - source_scanner,
-                                                                      reference.points[k] - views->target_scanner_m);
-            ++(same_side ? c.consistent : c.unseen);
-            continue;
-          }
-          if (!views) continue;
-          switch (views->target_free_space->classify(q)) {
-            case FreeSpaceImage::Seen::kSurface: ++c.consistent; break;
-            case FreeSpaceImage::Seen::kEmpty: ++c.contradicted; break;
-            case FreeSpaceImage::Seen::kOccluded:
-            case FreeSpaceImage::Seen::kUnknown: ++c.unseen; break;
-          }
-        }
-        return c;
-      },
-      [](Counts x, const Counts& y) {
-        return Counts{x.consistent + y.consistent, x.contradicted + y.contradicted, x.unseen + y.unseen};
-      });
-  const std::size_t consistent = counts.consistent, contradicted = counts.contradicted, unseen = counts.unseen;
-  // A pose that puts most points out of the target scanner's sight (behind its walls, say) has little
-  // evidence, and the few points left can all agree: the share is taken of at least half the overlap
-  // the caller expects, so such a pose cannot outscore one that the target sees well.
-  const double evidence = std::max(static_cast<double>(source.size() - unseen), 0.5 * overlap * source.size());
-  return (static_cast<double>(consistent) - static_cast<double>(contradicted)) / std::max(1.0, evidence);
-}
-
 // Centre of the middle 90 % of the points per axis: a room scan's stray points through windows and
 // doors must not pull it, and unlike the centroid it does not follow the scanner's dense near field.
 Eigen::Vector3f trimmed_centre(const std::vector<Eigen::Vector3f>& points) {
@@ -128,6 +78,56 @@ IcpPyramid thinned(const IcpPyramid& pyramid, std::size_t max_points) {
 }
 
 }  // namespace
+
+// Without views: the share of source points with a target point within tau. With the target's free
+// space, a point is also consistent where it lies at the target scanner's first return in its
+// direction (sparse far surfaces have gaps wider than tau), contradicted where the target scanner saw
+// through it, and no evidence either way where that scanner could not see it (behind its first return,
+// or no return) or where the two scanners saw its surface from opposite sides. Counting unseen points
+// as misses favours the pose that maps one scanner's occlusion shadows onto the other's — in a
+// symmetric room, the flip. So the score is, of the points with evidence, the share consistent less
+// the share contradicted.
+double cloud_score(const std::vector<Eigen::Vector3f>& source, const IcpPyramid::Stage& reference,
+                   const NeighborGrid& grid, float tau, const Eigen::Matrix4d& t, const ScanViews* views,
+                   double overlap) {
+  const Eigen::Affine3f a = to_affine3f(t);
+  const Eigen::Vector3f source_scanner = views ? Eigen::Vector3f(a * views->source_scanner_m) : Eigen::Vector3f::Zero();
+  struct Counts {
+    std::size_t consistent = 0, contradicted = 0, unseen = 0;
+  };
+  // Integer counts: the same for any split over threads.
+  const Counts counts = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, source.size(), 4096), Counts{},
+      [&](const tbb::blocked_range<std::size_t>& range, Counts c) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          const Eigen::Vector3f q = a * source[i];
+          const int k = grid.nearest_within(q, tau);
+          if (k >= 0) {
+            const bool same_side = !views || seen_from_the_same_side(reference.normals[k], q - source_scanner,
+                                                                      reference.points[k] - views->target_scanner_m);
+            ++(same_side ? c.consistent : c.unseen);
+            continue;
+          }
+          if (!views) continue;
+          switch (views->target_free_space->classify(q)) {
+            case FreeSpaceImage::Seen::kSurface: ++c.consistent; break;
+            case FreeSpaceImage::Seen::kEmpty: ++c.contradicted; break;
+            case FreeSpaceImage::Seen::kOccluded:
+            case FreeSpaceImage::Seen::kUnknown: ++c.unseen; break;
+          }
+        }
+        return c;
+      },
+      [](Counts x, const Counts& y) {
+        return Counts{x.consistent + y.consistent, x.contradicted + y.contradicted, x.unseen + y.unseen};
+      });
+  const std::size_t consistent = counts.consistent, contradicted = counts.contradicted, unseen = counts.unseen;
+  // A pose that puts most points out of the target scanner's sight (behind its walls, say) has little
+  // evidence, and the few points left can all agree: the share is taken of at least half the overlap
+  // the caller expects, so such a pose cannot outscore one that the target sees well.
+  const double evidence = std::max(static_cast<double>(source.size() - unseen), 0.5 * overlap * source.size());
+  return (static_cast<double>(consistent) - static_cast<double>(contradicted)) / std::max(1.0, evidence);
+}
 
 SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& target,
                                     std::vector<Hypothesis> hypotheses, double overlap, const ScanViews* views,

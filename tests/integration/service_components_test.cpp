@@ -194,8 +194,8 @@ TEST(MemoryBudgetTest, ReservesWaitsAndRefuses) {
 TEST(ProtoConvert, UnsetFieldsTakeTheCoreDefaults) {
   const RegistrationParams defaults;
   const RegistrationParams p = service::params_from_proto(v1::RegistrationParams{});
-  EXPECT_EQ(p.min_scale_m, 0.05);
-  EXPECT_EQ(p.overlap, 0.8);
+  EXPECT_EQ(p.min_scale_m, 0.0);  // automatic
+  EXPECT_EQ(p.overlap, 0.0);      // automatic
   EXPECT_TRUE(p.icp);
   EXPECT_EQ(p.seed, defaults.seed);
   EXPECT_EQ(p.octaves, defaults.octaves);
@@ -218,7 +218,7 @@ TEST(ProtoConvert, UnsetFieldsTakeTheCoreDefaults) {
   EXPECT_EQ(q.method, CoarseMethod::kPlain4pcs);
   EXPECT_EQ(q.time_budget_s, 3.0);
 
-  m.set_overlap(0);
+  m.set_overlap(-0.5);
   EXPECT_EQ(code_of([&] { service::params_from_proto(m); }), ErrorCode::kInvalidArgument);
 }
 

@@ -32,9 +32,15 @@ enum class FreeSpaceCheck {
 };
 
 struct RegistrationParams {
-  // The two parameters that matter (paper Tab. 1).
-  double min_scale_m = 0.05;  // minimum DoG scale sigma; also the voxel grid spacing
-  double overlap = 0.8;       // approximate overlap of the two scans, (0, 1]
+  // The two parameters that matter (paper Tab. 1); 0 = found from the data (the default).
+  // min_scale_m: minimum DoG scale sigma, also the voxel grid spacing. Automatic: the scans' robust
+  // diameter / 128 (at least twice their point spacing). Given or not, a scale that yields too few
+  // keypoints or no well-supported pose is halved, down to the point spacing (at most 4 scales).
+  double min_scale_m = 0.0;
+  // overlap: approximate overlap of the two scans, (0, 1]; it sets the number and width of the 4PCS
+  // bases. Automatic: rounds of fresh bases for an overlap of 0.8, 0.6, then 0.4, until a pose is well
+  // supported.
+  double overlap = 0.0;
 
   // DoG detector (paper Tab. 1 defaults).
   int octaves = 5;
@@ -64,7 +70,12 @@ struct Hypothesis {
   Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();  // source -> target
   double keypoint_score = 0.0;  // share of source keypoints with a target keypoint in tolerance
   double cloud_score = 0.0;     // share of voxelised source points with a target point in tolerance
+  // After a full refinement (leading hypotheses only; 0 otherwise): the cloud score again (pose_score.h).
+  double refined_score = 0.0;
 };
+
+// Below this margin between the best pose and the runner-up, the result is flagged ambiguous.
+constexpr double kAmbiguousMargin = 0.05;
 
 struct StageTiming {
   std::string stage;
@@ -81,7 +92,14 @@ struct RegistrationResult {
   std::size_t source_keypoints = 0, target_keypoints = 0;
   std::string signal;           // "intensity" or "geometric" (or "voxels" for plain 4PCS)
   bool free_space_used = false;
-  double ambiguity_margin = 0.0;  // (best - runner-up) / best cloud score; small = ambiguous (e.g. symmetry)
+  double min_scale_m_used = 0.0;  // the scale the result was found at
+  double overlap_used = 0.0;      // the overlap whose bases found it
+  // (best - runner-up) / best, on the evidence that decided (fine geometry and intensity); small = ambiguous.
+  double ambiguity_margin = 0.0;
+  // The evidence cannot tell the best pose from a runner-up (margin under kAmbiguousMargin), or the
+  // best pose is poorly supported: treat the transform as one of several candidates (see hypotheses).
+  bool ambiguous = false;
+  std::string ambiguity_reason;  // why, in words; empty when not ambiguous
   std::vector<Hypothesis> hypotheses;  // best first
   int bases_tried = 0;
   std::uint64_t seed = 0;

@@ -22,6 +22,9 @@ struct SurfaceSignal {
 std::vector<float> surface_variation(const std::vector<Eigen::Vector3f>& points, double radius_m,
                                      const CancellationToken* cancel = nullptr);
 
+// The name of the signal make_surface_signal picks: "intensity" or "geometric".
+std::string surface_signal_name(KeypointSignal requested, bool use_intensity);
+
 // Picks the signal for a voxelised cloud: `requested` kAuto means intensity when use_intensity is true.
 // Throws kInvalidArgument when intensity is requested but the cloud has none.
 SurfaceSignal make_surface_signal(const PointCloud& voxels, double voxel_m, KeypointSignal requested, bool use_intensity,

@@ -14,6 +14,7 @@
 #include "k4reg/cancellation.h"
 #include "k4reg/free_space.h"
 #include "k4reg/icp.h"
+#include "k4reg/neighbor_grid.h"
 #include "k4reg/point_cloud.h"
 #include "k4reg/registration.h"
 
@@ -31,6 +32,13 @@ struct ScanViews {
   Eigen::Vector3f source_scanner_m = Eigen::Vector3f::Zero();
   Eigen::Vector3f target_scanner_m = Eigen::Vector3f::Zero();
 };
+
+// The share of the source (points in its local frame) that the target explains under t: points with a
+// reference point within tau, less those the target scanner saw through, of the points it could see
+// (see symmetry_guard.cpp). grid: over reference.points, cells of at least tau.
+double cloud_score(const std::vector<Eigen::Vector3f>& source, const IcpPyramid::Stage& reference,
+                   const NeighborGrid& grid, float tau, const Eigen::Matrix4d& t, const ScanViews* views,
+                   double overlap);
 
 // Uses the two coarsest levels of the ICP pyramids and scores on the second. overlap: the expected share
 // of the source the target sees (the registration's parameter).
