@@ -166,7 +166,7 @@ Run run_one(const Suite& suite, std::size_t k, std::uint64_t seed) {
     run.note = r.ambiguity_reason;
     for (std::size_t h = 0; h < std::min<std::size_t>(3, r.hypotheses.size()); ++h) {
       char scores[128];
-      std::snprintf(scores, sizeof scores, " [#%zu cloud %.2f fine %.2f err %.3g]", h + 1,
+      std::snprintf(scores, sizeof scores, " [#%zu cloud %.2f refined %.2f err %.3g]", h + 1,
                     r.hypotheses[h].cloud_score, r.hypotheses[h].refined_score,
                     file_frame_error(pair.source, r.hypotheses[h].transform, pair.truth).rmse_m);
       run.note += scores;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include "k4reg/neighbor_grid.h"
 
@@ -11,11 +12,19 @@ namespace {
 
 constexpr std::size_t kSamplePoints = 20000;  // enough for a median to within a few per cent
 
-std::vector<Eigen::Vector3f> even_subsample(const std::vector<Eigen::Vector3f>& points, std::size_t count) {
-  const std::size_t step = std::max<std::size_t>(1, points.size() / count);
+// m points drawn at random (fixed seed; repeats dropped). Scans are stored in scan order, so every
+// k-th point would keep whole scan lines and drop others: its neighbour distances follow the lines.
+std::vector<Eigen::Vector3f> random_subsample(const std::vector<Eigen::Vector3f>& points, std::size_t count) {
+  if (points.size() <= count) return points;
+  std::mt19937_64 rng(1);
+  std::uniform_int_distribution<std::size_t> pick(0, points.size() - 1);
+  std::vector<std::size_t> indices(count);
+  for (std::size_t& i : indices) i = pick(rng);
+  std::sort(indices.begin(), indices.end());
+  indices.erase(std::unique(indices.begin(), indices.end()), indices.end());
   std::vector<Eigen::Vector3f> sample;
-  sample.reserve(points.size() / step + 1);
-  for (std::size_t i = 0; i < points.size(); i += step) sample.push_back(points[i]);
+  sample.reserve(indices.size());
+  for (const std::size_t i : indices) sample.push_back(points[i]);
   return sample;
 }
 
@@ -38,7 +47,7 @@ double robust_diameter(const std::vector<Eigen::Vector3f>& points) {
 Sampling measure_sampling(const PointCloud& cloud) {
   Sampling out;
   if (cloud.size() < 2) return out;
-  const std::vector<Eigen::Vector3f> sample = even_subsample(cloud.points, kSamplePoints);
+  const std::vector<Eigen::Vector3f> sample = random_subsample(cloud.points, kSamplePoints);
   out.diameter_m = robust_diameter(sample);
   if (!(out.diameter_m > 0.0)) return out;
   // Cells of a few typical neighbour distances of the subsample (a surface of this extent holding m points).
@@ -55,8 +64,16 @@ Sampling measure_sampling(const PointCloud& cloud) {
   }
   if (nearest.empty()) return out;
   std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
-  const double kept = static_cast<double>(sample.size()) / static_cast<double>(cloud.size());
-  out.spacing_m = nearest[nearest.size() / 2] * std::sqrt(kept);
+  const double median = nearest[nearest.size() / 2];
+  if (sample.size() == cloud.size()) {
+    out.spacing_m = median;
+  } else {
+    // A random subsample of a surface is a Poisson process of density rho * m / n, whose median
+    // nearest-neighbour distance is sqrt(ln 2 / pi) / sqrt(density): the full cloud's spacing
+    // 1 / sqrt(rho) (a grid's step) follows.
+    const double kept = static_cast<double>(sample.size()) / static_cast<double>(cloud.size());
+    out.spacing_m = median * std::sqrt(kept) / std::sqrt(std::log(2.0) / M_PI);
+  }
   return out;
 }
 

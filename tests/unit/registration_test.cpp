@@ -209,13 +209,19 @@ TEST(Registration, ClearErrors) {
   EXPECT_EQ(test::error_code_of([&] { register_clouds(bunny, bunny, intensity); }), ErrorCode::kInvalidArgument);
 }
 
+// 30 000 points uniform in a bunny-sized box: shares no structure with any scan.
+PointCloud random_box(unsigned seed) {
+  PointCloud noise;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-0.07f, 0.07f);
+  for (int i = 0; i < 30000; ++i) noise.points.emplace_back(u(rng), u(rng), u(rng));
+  return noise;
+}
+
 TEST(Registration, NoHypothesisIsFailedPrecondition) {
   // Keypoints exist, but a bunny scan and a random cloud share no congruent 4-point sets.
   const PointCloud bunny = read_cloud(kBunny + "bun000.ply");
-  PointCloud noise;
-  std::mt19937 rng(1);
-  std::uniform_real_distribution<float> u(-0.07f, 0.07f);
-  for (int i = 0; i < 30000; ++i) noise.points.emplace_back(u(rng), u(rng), u(rng));
+  const PointCloud noise = random_box(1);
   RegistrationParams p = bunny_params(0.9);
   p.max_bases = 10;
   const ErrorCode code = test::error_code_of([&] { register_clouds(bunny, noise, p); });
@@ -235,6 +241,42 @@ TEST(Registration, AutoSignalFallsBackToGeometryWhereIntensityCarriesNothing) {
   RegistrationParams intensity = bunny_params(pair.overlap);
   intensity.signal = KeypointSignal::kIntensity;
   EXPECT_EQ(test::error_code_of([&] { register_clouds(source, target, intensity); }), ErrorCode::kFailedPrecondition);
+}
+
+// With no minimum scale and no overlap given, both come from the scans: the result says which it used,
+// and the same scans in millimetres give the same pose (the translation in millimetres).
+TEST(Registration, AutomaticParametersFollowTheScansAndTheirUnits) {
+  const GtPair pair = bunny_pair("bun045.ply", "bun000.ply");
+  PointCloud source = read_cloud(kBunny + pair.source), target = read_cloud(kBunny + pair.target);
+  const RegistrationResult r = register_clouds(source, target, RegistrationParams{});
+  const TransformError e = transform_error(source.points, r.transform, pair.T_target_source);
+  EXPECT_LT(e.rmse_m, kBunnySuccess_m);
+  EXPECT_FALSE(r.ambiguous) << r.ambiguity_reason;
+  EXPECT_GT(r.min_scale_m_used, 0.0002);  // between the point spacing and 1/100 of the object
+  EXPECT_LT(r.min_scale_m_used, 0.002);
+  EXPECT_GE(r.overlap_used, 0.4);
+  EXPECT_LE(r.overlap_used, 0.8);
+  for (PointCloud* cloud : {&source, &target})
+    for (Eigen::Vector3f& p : cloud->points) p *= 1000.0f;
+  const RegistrationResult mm = register_clouds(source, target, RegistrationParams{});
+  EXPECT_NEAR(mm.min_scale_m_used, 1000.0 * r.min_scale_m_used, 1e-3 * mm.min_scale_m_used);
+  EXPECT_EQ(mm.overlap_used, r.overlap_used);
+  EXPECT_LT((mm.transform.topLeftCorner<3, 3>() - r.transform.topLeftCorner<3, 3>()).norm(), 1e-3);
+  EXPECT_LT((mm.transform.topRightCorner<3, 1>() - 1000.0 * r.transform.topRightCorner<3, 1>()).norm(), 1.0);  // < 1 mm
+}
+
+// Scans that share nothing: every scale and overlap is tried, and the answer is a refusal or a flagged
+// pose, never a confident one.
+TEST(Registration, ScansThatShareNothingAreNeverConfident) {
+  const PointCloud bunny = read_cloud(kBunny + "bun000.ply");
+  const PointCloud noise = random_box(3);
+  try {
+    const RegistrationResult r = register_clouds(bunny, noise, RegistrationParams{});
+    EXPECT_TRUE(r.ambiguous);
+    EXPECT_FALSE(r.ambiguity_reason.empty());
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kFailedPrecondition) << e.what();
+  }
 }
 
 TEST(Registration, PlainFourPcsBaselineIsSelectable) {
