@@ -65,6 +65,35 @@ AngularGrid grid_for(double rays, double azimuth0_rad) {
   return g;
 }
 
+// The object range scanner's rays: through the centres of a columns x rows grid of pixels of equal
+// pitch on the image plane, over a square field of view around `forward` (a camera's sampling).
+struct FrustumGrid {
+  Vector3d forward, right, up;  // unit, orthogonal; right and up span the image plane
+  double tan_half = 0.0;        // tangent of half the field of view
+  double step_rad = 0.0;        // angular pitch at the centre of the view
+  std::size_t columns = 0, rows = 0;
+
+  std::size_t rays() const { return columns * rows; }
+  Vector3d direction(std::size_t column, std::size_t row) const {
+    const double a = tan_half * (2.0 * (static_cast<double>(column) + 0.5) / static_cast<double>(columns) - 1.0);
+    const double b = tan_half * (2.0 * (static_cast<double>(row) + 0.5) / static_cast<double>(rows) - 1.0);
+    return (forward + a * right + b * up).normalized();
+  }
+};
+
+FrustumGrid frustum_for(double rays, const Vector3d& forward, double field_of_view_rad) {
+  FrustumGrid g;
+  g.forward = forward;
+  // Image rows stay horizontal unless the scanner looks (nearly) straight up or down.
+  const Vector3d level = std::abs(forward.z()) < 0.999 ? Vector3d::UnitZ() : Vector3d::UnitX();
+  g.right = forward.cross(level).normalized();
+  g.up = g.right.cross(forward);
+  g.tan_half = std::tan(0.5 * field_of_view_rad);
+  g.columns = g.rows = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(std::sqrt(rays))));
+  g.step_rad = field_of_view_rad / static_cast<double>(g.columns);
+  return g;
+}
+
 struct Return {
   Vector3d point_m;
   float intensity;
@@ -115,28 +144,35 @@ Eigen::Matrix3d random_rotation(RandomStream& rng) {
   }
 }
 
-void validate(const ScanParams& params) {
-  if (params.points < 1000 || params.points > kMaxPoints)
+void validate(std::size_t points, double noise_m, const ScanParams& params, const Station& station) {
+  if (points < 1000 || points > kMaxPoints)
     fail(ErrorCode::kInvalidArgument, "points must be between 1000 and " + std::to_string(kMaxPoints) + ", not " +
-                                          std::to_string(params.points));
-  if (!(params.noise_m >= 0.0 && params.noise_m <= 1.0))
-    fail(ErrorCode::kInvalidArgument, "range noise must be between 0 and 1 m, not " + std::to_string(params.noise_m));
+                                          std::to_string(points));
+  if (!(noise_m >= 0.0 && noise_m <= 1.0))
+    fail(ErrorCode::kInvalidArgument, "range noise must be between 0 and 1 m, not " + std::to_string(noise_m));
   if (!(params.max_range_m >= 0.0 && std::isfinite(params.max_range_m)))
     fail(ErrorCode::kInvalidArgument, "maximum range must be >= 0 m (0 = scene default), not " +
                                           std::to_string(params.max_range_m));
+  if (station.look_at_m && !((*station.look_at_m - station.position_m).norm() > 0.0 &&
+                             station.field_of_view_deg > 0.0 && station.field_of_view_deg < 170.0))
+    fail(ErrorCode::kInvalidArgument, "an aimed station needs a target away from it and a field of view in (0, 170) deg");
 }
 
 }  // namespace
 
 SimulatedScan simulate_scan(const Scene& scene, int station, const ScanParams& params) {
   std::vector<Primitive> primitives = scene.primitives_seen_from(station);  // checks the station
-  validate(params);
+  const Station& where = scene.stations[station];
+  const std::size_t points_wanted = params.points > 0 ? params.points : scene.default_points;
+  const double noise_m = params.noise_m.value_or(scene.default_noise_m);
+  validate(points_wanted, noise_m, params, where);
   const double max_range_m = params.max_range_m > 0.0 ? params.max_range_m : scene.default_max_range_m;
   const SceneIndex index(std::move(primitives));
-  const Vector3d origin = scene.stations[station].position_m;
+  const Vector3d origin = where.position_m;
 
   std::uint64_t scene_key = 0xcbf29ce484222325ULL;  // FNV-1a of the name: each scene has its own rotations
   for (const char c : scene.name) scene_key = (scene_key ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL;
+  if (scene.layout > 0) scene_key = derive_key(scene_key, static_cast<std::uint64_t>(scene.layout));  // its own rotations too
   const std::uint64_t scan_key = derive_key(derive_key(params.seed, scene_key), static_cast<std::uint64_t>(station));
   RandomStream scan_rng(scan_key);
   const double azimuth0_rad = 2.0 * std::numbers::pi * scan_rng.uniform();  // scanners start anywhere
@@ -145,7 +181,7 @@ SimulatedScan simulate_scan(const Scene& scene, int station, const ScanParams& p
 
   // Each column is traced by one task into its own buffers, which are concatenated in column order;
   // every ray's random stream depends only on its index, so the result is independent of threading.
-  auto trace = [&](const AngularGrid& grid, std::uint64_t rays_key, std::vector<std::vector<Eigen::Vector3f>>& points,
+  auto trace = [&](const auto& grid, std::uint64_t rays_key, std::vector<std::vector<Eigen::Vector3f>>& points,
                    std::vector<std::vector<float>>& intensity) {
     points.assign(grid.columns, {});
     intensity.assign(grid.columns, {});
@@ -153,10 +189,11 @@ SimulatedScan simulate_scan(const Scene& scene, int station, const ScanParams& p
       for (std::size_t c = r.begin(); c != r.end(); ++c) {
         for (std::size_t row = 0; row < grid.rows; ++row) {
           RandomStream rng(derive_key(rays_key, c * grid.rows + row));
-          const auto ret = measure(index, origin, grid.direction(c, row), max_range_m, params.noise_m, rng);
+          const Vector3d direction = grid.direction(c, row);
+          const auto ret = measure(index, origin, direction, max_range_m, noise_m, rng);
           if (!ret) continue;
           points[c].push_back((scene_to_scan_rotation * (ret->point_m - origin)).cast<float>());
-          intensity[c].push_back(ret->intensity);
+          if (scene.intensity) intensity[c].push_back(ret->intensity);
         }
       }
     });
@@ -165,22 +202,33 @@ SimulatedScan simulate_scan(const Scene& scene, int station, const ScanParams& p
   std::vector<std::vector<float>> intensity;
 
   // A coarse pilot scan measures the hit fraction (sky, windows and range limit return nothing), so the
-  // real scan can cast just enough rays for the requested number of points.
-  const AngularGrid pilot = grid_for(static_cast<double>(kPilotRays), azimuth0_rad);
-  trace(pilot, derive_key(scan_key, 1), points, intensity);
-  std::size_t pilot_hits = 0;
-  for (const auto& column : points) pilot_hits += column.size();
-  const double hit_fraction =
-      std::max(kMinHitFraction, static_cast<double>(pilot_hits) / static_cast<double>(pilot.rays()));
-  const AngularGrid grid = grid_for(static_cast<double>(params.points) / hit_fraction, azimuth0_rad);
-  trace(grid, derive_key(scan_key, 2), points, intensity);
-
+  // real scan can cast just enough rays for the requested number of points. grid_of(rays) lays the rays.
   SimulatedScan scan;
+  auto pilot_then_scan = [&](const auto& grid_of) {
+    const auto pilot = grid_of(static_cast<double>(kPilotRays));
+    trace(pilot, derive_key(scan_key, 1), points, intensity);
+    std::size_t pilot_hits = 0;
+    for (const auto& column : points) pilot_hits += column.size();
+    const double hit_fraction =
+        std::max(kMinHitFraction, static_cast<double>(pilot_hits) / static_cast<double>(pilot.rays()));
+    const auto grid = grid_of(static_cast<double>(points_wanted) / hit_fraction);
+    trace(grid, derive_key(scan_key, 2), points, intensity);
+    scan.step_rad = grid.step_rad;
+    scan.rays = grid.rays();
+  };
+  if (where.look_at_m) {
+    const Vector3d forward = (*where.look_at_m - origin).normalized();
+    const double field_of_view_rad = where.field_of_view_deg * kDegree;
+    pilot_then_scan([&](double rays) { return frustum_for(rays, forward, field_of_view_rad); });
+  } else {
+    pilot_then_scan([&](double rays) { return grid_for(rays, azimuth0_rad); });
+  }
+
   std::size_t total = 0;
   for (const auto& column : points) total += column.size();
   scan.cloud.points.reserve(total);
-  scan.cloud.intensity.reserve(total);
-  for (std::size_t c = 0; c < grid.columns; ++c) {
+  if (scene.intensity) scan.cloud.intensity.reserve(total);
+  for (std::size_t c = 0; c < points.size(); ++c) {
     scan.cloud.points.insert(scan.cloud.points.end(), points[c].begin(), points[c].end());
     scan.cloud.intensity.insert(scan.cloud.intensity.end(), intensity[c].begin(), intensity[c].end());
     std::vector<Eigen::Vector3f>().swap(points[c]);  // keeps the peak memory near one copy of the scan
@@ -190,8 +238,6 @@ SimulatedScan simulate_scan(const Scene& scene, int station, const ScanParams& p
   scan.scan_to_scene.topLeftCorner<3, 3>() = scan_to_scene_rotation;
   scan.scan_to_scene.topRightCorner<3, 1>() = origin;
   scan.station_m = origin;
-  scan.step_rad = grid.step_rad;
-  scan.rays = grid.rays();
   return scan;
 }
 

@@ -1,6 +1,7 @@
 // The terrestrial laser scanner: constant angular sampling over 360 deg x 150 deg (elevation -60 to
 // +90 deg; the cone below the tripod is blind), so the point density on a surface falls off with the
-// square of the range as in a real TLS. Each return has Gaussian range noise and an intensity from the
+// square of the range as in a real TLS. A station with a look_at_m is an object range scanner instead:
+// a square camera-like grid of rays over its field of view, aimed at that point. Each return has Gaussian range noise and an intensity from the
 // surface's reflectivity, the incidence angle and a mild range attenuation; grazing and dark hits drop
 // out, glass mostly transmits, foliage is half transparent.
 //
@@ -12,6 +13,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 
 #include "k4reg/point_cloud.h"
 #include "sim/scene.h"
@@ -21,14 +23,14 @@ namespace k4reg::sim {
 struct ScanParams {
   // Points wanted. The angular step is chosen so that rays x (hit fraction of a coarse pilot scan from
   // the same station) = points, so the result lands within a few per cent of this.
-  std::size_t points = 700000;
-  std::uint64_t seed = 1;      // reproduces the scan bit for bit, for any thread count
-  double noise_m = 0.002;      // range noise standard deviation
-  double max_range_m = 0;      // 0 = the scene's default
+  std::size_t points = 0;                // 0 = the scene's default (700000 for the terrestrial scenes)
+  std::uint64_t seed = 1;                // reproduces the scan bit for bit, for any thread count
+  std::optional<double> noise_m;         // range noise standard deviation; unset = the scene's default
+  double max_range_m = 0;                // 0 = the scene's default
 };
 
 struct SimulatedScan {
-  k4reg::PointCloud cloud;          // scan frame, with intensity in [0, 1]
+  k4reg::PointCloud cloud;          // scan frame, with intensity in [0, 1] if the scene records it
   Eigen::Matrix4d scan_to_scene;    // ground truth: maps scan points into the scene frame
   Eigen::Vector3d station_m;        // scanner position in the scene frame
   double step_rad = 0.0;            // angular step, the same horizontally and vertically

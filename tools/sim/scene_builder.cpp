@@ -5,6 +5,15 @@
 
 namespace k4reg::sim {
 
+Scene empty_scene(std::string name, int layout, std::string description, double default_max_range_m) {
+  Scene scene;
+  scene.name = std::move(name);
+  scene.layout = layout;
+  scene.description = std::move(description);
+  scene.default_max_range_m = default_max_range_m;
+  return scene;
+}
+
 Surface paint(const Pattern& pattern, Material material) { return Surface{pattern, {}, material}; }
 
 Primitive box_between(const Eigen::Vector3d& min_m, const Eigen::Vector3d& max_m, const Surface& surface) {
@@ -58,7 +67,10 @@ void add_wall(std::vector<Primitive>& out, const WallSpec& wall) {
       out.push_back(box_between(at(o.u_min_m, o.v_max_m, 0.0), at(o.u_max_m, o.v_max_m + kCasing_m, -kProud_m), casing));
     } else {
       out.push_back(rect(at(o.u_min_m, o.v_min_m, 0.0), wall.along, outward, w, depth, reveal));
-      out.push_back(rect(at(o.u_min_m, o.v_min_m, 0.6 * depth), wall.along, up, w, h, paint(uniform(0.1), Material::kGlass)));
+      if (o.recess_m > 0.0)
+        out.push_back(rect(at(o.u_min_m, o.v_min_m, o.recess_m), wall.along, up, w, h, paint(uniform(0.3))));
+      else
+        out.push_back(rect(at(o.u_min_m, o.v_min_m, 0.6 * depth), wall.along, up, w, h, paint(uniform(0.1), Material::kGlass)));
     }
   };
 
@@ -85,6 +97,20 @@ void add_wall(std::vector<Primitive>& out, const WallSpec& wall) {
   if (wall.interior_depth_m > 0.0)
     out.push_back(rect(at(0.0, 0.0, wall.interior_depth_m), wall.along, up, wall.length_m, wall.height_m,
                        paint(uniform(0.12))));
+}
+
+void add_room_walls(std::vector<Primitive>& out, const RoomSpec& room) {
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), y = Eigen::Vector3d::UnitY();
+  const double l = room.length_m, w = room.width_m;
+  const std::array<Eigen::Vector3d, 4> starts = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(l, 0, 0), Eigen::Vector3d(l, w, 0),
+                                                 Eigen::Vector3d(0, w, 0)};
+  const std::array<Eigen::Vector3d, 4> alongs = {x, y, -x, -y};
+  const std::array<double, 4> lengths = {l, w, l, w};
+  for (int i = 0; i < 4; ++i) {
+    const Eigen::Vector3d inward = Eigen::Vector3d::UnitZ().cross(alongs[i]);  // left of the walking direction
+    add_wall(out, WallSpec{starts[i], alongs[i], inward, lengths[i], room.height_m, room.thickness_m, room.interior_depth_m,
+                           room.surfaces[i], room.openings[i]});
+  }
 }
 
 }  // namespace k4reg::sim

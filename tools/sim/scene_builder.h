@@ -3,6 +3,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
+#include <string>
 #include <vector>
 
 #include "sim/primitives.h"
@@ -26,6 +28,8 @@ Primitive ellipsoid(const Eigen::Vector3d& center_m, const Eigen::Vector3d& radi
 struct Opening {
   double u_min_m, u_max_m, v_min_m, v_max_m;
   bool door = false;  // doors get an opaque leaf and a handle, windows a glass pane and a sill
+  double recess_m = 0.0;  // windows only: > 0 = an open recess this deep behind the wall face, with an
+                          // opaque back instead of the pane (a niche; an open doorway with the room behind)
 };
 
 // A vertical wall seen from its inner side. Its pattern uses wall coordinates, so zones (posters)
@@ -43,7 +47,29 @@ struct WallSpec {
 
 void add_wall(std::vector<Primitive>& out, const WallSpec& wall);
 
+// The four walls of the axis-aligned room [0, length] x [0, width] x [0, height], seen from inside, in
+// the order south (y = 0), east (x = length), north, west, each starting where the previous one ends.
+// A half turn about the room's vertical axis maps south onto north and east onto west with the same
+// wall coordinate u, so equal opening lists on opposite walls make a half-turn symmetric shell.
+struct RoomSpec {
+  double length_m = 1.0, width_m = 1.0, height_m = 1.0;
+  double thickness_m = 0.3;
+  double interior_depth_m = 0.0;                 // see WallSpec: rooms behind the windows
+  std::array<Surface, 4> surfaces;               // south, east, north, west
+  std::array<std::vector<Opening>, 4> openings;  // south, east, north, west
+};
+
+void add_room_walls(std::vector<Primitive>& out, const RoomSpec& room);
+
+// A scene with its name, layout, description and default range set, to be filled in.
+Scene empty_scene(std::string name, int layout, std::string description, double default_max_range_m);
+
 Scene make_lab_scene();
 Scene make_arch_scene();
+Scene make_hall_scene(int layout);
+Scene make_corridor_scene(int layout);
+Scene make_monument_scene(int layout);
+Scene make_courtyard_scene(int layout);
+Scene make_object_scene(int layout);
 
 }  // namespace k4reg::sim
