@@ -10,6 +10,7 @@
 // the one outcome a registration service must not give). Real sources are moved by a random rigid motion
 // first (seeded), as a user's scans in arbitrary scanner frames would be.
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
 
 #include <Eigen/Geometry>
 
@@ -109,14 +110,29 @@ Suite real_suite(std::string name, std::string part, std::string what, const fs:
 }
 
 // Station pairs of a simulated scene (scans cached on disk; the simulator gives every scan its own frame).
-Suite simulated_suite(std::string name, std::string part, std::string what, std::string scene,
-                      std::vector<std::pair<int, int>> stations, std::size_t points, double threshold,
-                      double min_scale_m, double overlap, std::string cache_dir) {
-  Suite s{std::move(name), std::move(part), std::move(what), min_scale_m, overlap, threshold, {}, {}};
-  for (auto [a, b] : stations) s.pairs.push_back(scene + " " + std::to_string(a) + "->" + std::to_string(b));
+// Station pairs of one layout of a simulated scene, with the success threshold and the fixed sigma that
+// its "-sigma" suite uses.
+struct SceneSet {
+  std::string scene;
+  int layout = 0;
+  std::vector<std::pair<int, int>> stations;
+  std::size_t points = 700000;
+  double success_rmse_m = 0.1;
+  double fixed_sigma_m = 0.1;
+};
+
+// The scans are cached on disk; the simulator gives every scan its own frame.
+Suite simulated_suite(const SceneSet& set, std::string part, bool automatic, const std::string& cache_dir) {
+  const std::string label = set.scene + (set.layout > 0 ? "-L" + std::to_string(set.layout) : "");
+  const std::string name = label + (automatic ? "-auto" : "-sigma");
+  const std::string what = set.scene + " layout " + std::to_string(set.layout) +
+                           (automatic ? ", automatic sigma and overlap"
+                                      : fmt::format(", sigma {} m, automatic overlap", set.fixed_sigma_m));
+  Suite s{name, std::move(part), what, automatic ? 0.0 : set.fixed_sigma_m, 0.0, set.success_rmse_m, {}, {}};
+  for (auto [a, b] : set.stations) s.pairs.push_back(label + " " + std::to_string(a) + "->" + std::to_string(b));
   s.load = [=](std::size_t k, std::uint64_t) {
-    const CachedScan a = cached_simulated_scan(cache_dir, scene, stations.at(k).first, points);
-    const CachedScan b = cached_simulated_scan(cache_dir, scene, stations.at(k).second, points);
+    const CachedScan a = cached_simulated_scan(cache_dir, set.scene, set.stations.at(k).first, set.points, set.layout);
+    const CachedScan b = cached_simulated_scan(cache_dir, set.scene, set.stations.at(k).second, set.points, set.layout);
     return Pair{read_cloud(a.path), read_cloud(b.path), source_to_target_truth(a, b)};
   };
   return s;
@@ -137,11 +153,31 @@ std::vector<Suite> all_suites(const fs::path& data, const std::string& cache) {
   // Real indoor scans in centimetres, never tuned on.
   suites.push_back(real_suite("kurt3d-cm-auto", "held-out", "3DTK Kurt3D indoor scans as given (cm), automatic", kurt,
                               {0}, 25.0, 0.0, 0.0, 500.0));
-  // Simulated: the lab's pairs tune; the arch (outdoor) is held out.
-  suites.push_back(simulated_suite("lab-auto", "tuning", "lab, automatic sigma and overlap", "lab",
-                                   {{0, 1}, {2, 3}, {1, 4}}, 700000, 0.5, 0.0, 0.0, cache));
-  suites.push_back(simulated_suite("arch-auto", "held-out", "arch (outdoor), automatic sigma and overlap", "arch",
-                                   {{0, 1}, {2, 3}}, 1500000, 1.0, 0.0, 0.0, cache));
+  // Simulated. Tuning: the lab and the canonical layout (0) of the hall, the corridor and the object.
+  // Held out: whole scenes never tuned on (monument, courtyard, arch) and other layouts of the tuning
+  // scenes (their dimensions, details and stations drawn afresh).
+  const std::vector<std::pair<int, int>> hall_pairs{{0, 1}, {2, 3}}, corridor_pairs{{0, 1}, {1, 2}},
+      object_pairs{{0, 1}, {3, 4}, {7, 8}}, monument_pairs{{0, 1}, {0, 3}, {3, 2}},
+      courtyard_pairs{{0, 1}, {1, 2}, {2, 3}, {3, 0}};
+  const std::vector<std::pair<SceneSet, std::string>> sets{
+      {{"lab", 0, {{0, 1}, {2, 3}, {1, 4}}}, "tuning"},
+      {{"hall", 0, {{0, 1}, {2, 3}, {0, 4}}}, "tuning"},
+      {{"corridor", 0, corridor_pairs}, "tuning"},
+      {{"object", 0, {{0, 1}, {2, 3}, {5, 6}}, 40000, 0.005, 0.002}, "tuning"},
+      {{"hall", 1, hall_pairs}, "held-out"},
+      {{"hall", 2, hall_pairs}, "held-out"},
+      {{"corridor", 1, corridor_pairs}, "held-out"},
+      {{"corridor", 2, corridor_pairs}, "held-out"},
+      {{"object", 1, object_pairs, 40000, 0.005, 0.002}, "held-out"},
+      {{"object", 2, object_pairs, 40000, 0.005, 0.002}, "held-out"},
+      {{"monument", 0, monument_pairs, 1500000}, "held-out"},
+      {{"monument", 1, monument_pairs, 1500000}, "held-out"},
+      {{"courtyard", 0, courtyard_pairs}, "held-out"},
+      {{"courtyard", 1, courtyard_pairs}, "held-out"},
+      {{"arch", 0, {{0, 1}, {2, 3}}, 1500000}, "held-out"},
+  };
+  for (const auto& [set, part] : sets)
+    for (bool automatic : {true, false}) suites.push_back(simulated_suite(set, part, automatic, cache));
   return suites;
 }
 

@@ -15,11 +15,11 @@ struct CachedScan {
   Eigen::Matrix4d scan_to_scene;   // ground truth: scan frame -> scene frame
 };
 
-// The scan of `station` with about `points` points (simulator seed = station + 1), simulated into cache_dir
-// on first use as <scene>-station<k>-<points>-seed<k+1>.ply and .gt.txt. Throws k4reg::Error for an
-// unknown scene or station and for files that cannot be written or read.
+// The scan of `station` of the scene's `layout` with about `points` points (simulator seed = station + 1),
+// simulated into cache_dir on first use as <scene>[-layout<n>]-station<k>-<points>-seed<k+1>.ply and .gt.txt.
+// Throws k4reg::Error for an unknown scene, layout or station and for files that cannot be written or read.
 CachedScan cached_simulated_scan(const std::string& cache_dir, const std::string& scene, int station,
-                                 std::size_t points);
+                                 std::size_t points, int layout = 0);
 
 // T_target_source: maps source scan coordinates onto the target scan.
 inline Eigen::Matrix4d source_to_target_truth(const CachedScan& source, const CachedScan& target) {

@@ -72,7 +72,8 @@ RegistrationResult result_from_proto(const v1::RegistrationResult& m) {
   r.min_scale_m_used = m.min_scale_m_used();
   r.overlap_used = m.overlap_used();
   for (const v1::Hypothesis& h : m.hypotheses())
-    r.hypotheses.push_back({matrix_from_proto(h.transform()), h.keypoint_score(), h.cloud_score(), h.refined_score()});
+    r.hypotheses.push_back({matrix_from_proto(h.transform()), h.keypoint_score(), h.cloud_score(), h.refined_score(),
+                            h.surface_agreement()});
   r.bases_tried = m.bases_tried();
   r.seed = m.seed();
   r.icp_converged = m.icp_converged();

@@ -44,7 +44,8 @@ nlohmann::json result_to_json(const RegistrationResult& r) {
         {{"transform", matrix_to_json(h.transform)},
          {"keypoint_score", h.keypoint_score},
          {"cloud_score", h.cloud_score},
-         {"refined_score", h.refined_score}});
+         {"refined_score", h.refined_score},
+         {"surface_agreement", h.surface_agreement}});
   j["timings"] = nlohmann::json::array();
   for (const StageTiming& t : r.timings) j["timings"].push_back({{"stage", t.stage}, {"seconds", t.seconds}});
   return j;
@@ -65,7 +66,8 @@ void print_result_table(std::ostream& out, const RegistrationResult& r) {
   for (std::size_t k = 0; k < r.hypotheses.size(); ++k) {
     const Hypothesis& h = r.hypotheses[k];
     out << fmt::format("  #{}  cloud score {:.3f}  keypoint score {:.3f}", k + 1, h.cloud_score, h.keypoint_score);
-    if (h.refined_score > 0) out << fmt::format("  refined score {:.3f}", h.refined_score);
+    if (h.refined_score > 0)
+      out << fmt::format("  refined score {:.3f}  surface agreement {:.2f}", h.refined_score, h.surface_agreement);
     out << "\n";
   }
   out << fmt::format("{:<22}{}\n", "seed", r.seed);

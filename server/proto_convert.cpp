@@ -115,6 +115,7 @@ void result_to_proto(const RegistrationResult& r, v1::RegistrationResult* m) {
     out->set_keypoint_score(h.keypoint_score);
     out->set_cloud_score(h.cloud_score);
     out->set_refined_score(h.refined_score);
+    out->set_surface_agreement(h.surface_agreement);
   }
   m->set_bases_tried(r.bases_tried);
   m->set_seed(r.seed);

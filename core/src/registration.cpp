@@ -341,10 +341,9 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
       refined[i] = refine_icp(icp.first, icp.second, result.hypotheses[i].transform, final_params, cancel);
     return 0;
   });
-  // Per contender: the share of the source the target explains once refined. Contenders that refined into
-  // an earlier one's pose drop out.
+  // Per contender: the share of the source the target explains once refined, and how much of what comes
+  // near the target surface lies on it. Contenders that refined into an earlier one's pose drop out.
   const PoseScorer scorer(icp.first, icp.second, free_space ? &views : nullptr, result.overlap_used);
-  std::vector<double> refined_scores;
   std::vector<std::size_t> kept;
   timer.run("verdict", [&] {
     for (std::size_t i = 0; i < contenders; ++i) {
@@ -355,26 +354,33 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
           }))
         continue;
       h.refined_score = scorer.score(h.transform);
+      if (params.icp) h.surface_agreement = scorer.surface_agreement(h.transform);
       kept.push_back(i);
-      refined_scores.push_back(h.refined_score);
     }
     return 0;
   });
-  std::vector<std::size_t> order(kept.size());  // positions in kept, best first
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return refined_scores[a] > refined_scores[b]; });
-  const std::size_t winner = kept[order[0]];
-  if (kept.size() > 1)
+  // A pose off the target surface cannot be the true one, however well supported: contenders on the
+  // surface rank first, then by support (unrefined poses, with --no-icp, are not judged on the surface).
+  auto on_surface = [&](std::size_t i) { return !params.icp || result.hypotheses[i].surface_agreement >= kMinSurfaceAgreement; };
+  std::stable_sort(kept.begin(), kept.end(), [&](std::size_t a, std::size_t b) {
+    if (on_surface(a) != on_surface(b)) return on_surface(a);
+    return result.hypotheses[a].refined_score > result.hypotheses[b].refined_score;
+  });
+  const std::size_t winner = kept[0];
+  // The runner-up is the next contender of the winner's kind; failing one, the best unrefined hypothesis.
+  const auto rival = std::find_if(kept.begin() + 1, kept.end(), [&](std::size_t i) { return on_surface(i) == on_surface(winner); });
+  const double winner_score = result.hypotheses[winner].refined_score;
+  if (rival != kept.end())
     result.ambiguity_margin =
-        refined_scores[order[0]] > 0 ? std::clamp((refined_scores[order[0]] - refined_scores[order[1]]) / refined_scores[order[0]], 0.0, 1.0) : 0.0;
-  else if (contenders > 1)  // the runner-ups refined into the winner: the next hypothesis is the runner-up
+        winner_score > 0 ? std::clamp((winner_score - result.hypotheses[*rival].refined_score) / winner_score, 0.0, 1.0) : 0.0;
+  else if (contenders > 1)
     result.ambiguity_margin =
         contenders < result.hypotheses.size()
             ? std::clamp(1.0 - result.hypotheses[contenders].cloud_score / result.hypotheses[winner].cloud_score, 0.0, 1.0)
             : 1.0;
   // The winner first, the other contenders after it, the rest as they were.
   std::vector<Hypothesis> reordered;
-  for (std::size_t i : order) reordered.push_back(result.hypotheses[kept[i]]);
+  for (std::size_t i : kept) reordered.push_back(result.hypotheses[i]);
   reordered.insert(reordered.end(), result.hypotheses.begin() + contenders, result.hypotheses.end());
   result.hypotheses = std::move(reordered);
   const IcpResult& final_icp = refined[winner];
@@ -388,7 +394,14 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
 
   // The smallest overlap searched sets what a true pose must explain.
   const double needed = well_supported(overlaps[std::min(rounds_run, overlaps.size()) - 1]);
-  if (best.refined_score < needed) {
+  const bool on_the_surface = !params.icp || best.surface_agreement >= kMinSurfaceAgreement;
+  if (!on_the_surface) {
+    result.ambiguous = true;
+    result.ambiguity_reason = fmt::format(
+        "off the surface: once refined, {:.0f} % of the source points near the target lie on its surface (true "
+        "poses: {:.0f} % or more)",
+        100 * best.surface_agreement, 100 * kMinSurfaceAgreement);
+  } else if (best.refined_score < needed) {
     result.ambiguous = true;
     result.ambiguity_reason = fmt::format(
         "poorly supported: the best pose explains {:.0f} % of the source once refined (true poses: {:.0f} % or more)",
@@ -402,7 +415,8 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
 
   result.transform = to_file_frames(local, source.origin_m, target.origin_m);
   for (Hypothesis& h : result.hypotheses) h.transform = to_file_frames(h.transform, source.origin_m, target.origin_m);
-  return {std::move(result), best.refined_score >= needed};
+  const bool supported = on_the_surface && best.refined_score >= needed;
+  return {std::move(result), supported};
 }
 
 // The scales to try, coarsest first: the caller's or the automatic start, halved while a scale finds
@@ -414,7 +428,8 @@ class ScaleLadder {
     if (start_m_ == 0.0) {
       const Sampling s = measure_sampling(source), t = measure_sampling(target);
       spacing_m_ = std::max(s.spacing_m, t.spacing_m);
-      start_m_ = std::max(std::min(s.diameter_m, t.diameter_m) / kDiameterPerScale, 2.0 * spacing_m_);
+      const double coarsest = std::min(s.diameter_m, t.diameter_m) / kDiameterPerScale;
+      start_m_ = std::max(std::min(coarsest, kSpacingsPerScale * spacing_m_), 2.0 * spacing_m_);
       if (!(start_m_ > 0.0))
         fail(ErrorCode::kInvalidArgument, "the clouds have no extent: all points coincide");
     }
@@ -428,9 +443,12 @@ class ScaleLadder {
   }
 
  private:
-  // DoG scales run from sigma to 2^5 sigma: at diameter / 128 the coarsest octave still sees a quarter
-  // of the scene, so a scan of any size and unit yields keypoints at every octave.
+  // The start: DoG scales run from sigma to 2^5 sigma, and at diameter / 128 the coarsest octave still
+  // sees a quarter of the scene, so a scan of any size and unit yields keypoints at every octave. No
+  // coarser than 10 point spacings, though (a voxel then averages ~100 points): a large outdoor scene,
+  // dense near the scanner, would otherwise start at a scale that only its far field needs.
   static constexpr double kDiameterPerScale = 128.0;
+  static constexpr double kSpacingsPerScale = 10.0;
   static constexpr int kMaxScales = 4;
   const PointCloud& source_;
   const PointCloud& target_;
@@ -461,10 +479,10 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
     try {
       ScaleAttempt attempt = register_at_scale(source, target, params, sigma, cancel, progress);
       add_timings(timings, attempt.result.timings);
+      // The first well-supported pose stands; failing one, the best supported of all scales tried.
       const double support = attempt.result.hypotheses.front().refined_score;
-      const bool supported = attempt.supported;
-      if (!best || support > best->hypotheses.front().refined_score) best = std::move(attempt.result);
-      if (supported) break;
+      if (attempt.supported || !best || support > best->hypotheses.front().refined_score) best = std::move(attempt.result);
+      if (attempt.supported) break;
     } catch (const Error& e) {
       if (e.code() != ErrorCode::kFailedPrecondition) throw;
       if (!failure) failure = e;

@@ -70,9 +70,15 @@ struct Hypothesis {
   Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();  // source -> target
   double keypoint_score = 0.0;  // share of source keypoints with a target keypoint in tolerance
   double cloud_score = 0.0;     // share of voxelised source points with a target point in tolerance
-  // After a full refinement (leading hypotheses only; 0 otherwise): the cloud score again (pose_score.h).
+  // After a full refinement (leading hypotheses only; 0 otherwise): the cloud score again, and the share
+  // of the source points near the target surface that lie on it, within half the minimum scale
+  // (pose_score.h). A true pose puts them on it; a wrong one only touches it.
   double refined_score = 0.0;
+  double surface_agreement = 0.0;
 };
+
+// A refined pose with less surface agreement than this is not taken as well supported.
+constexpr double kMinSurfaceAgreement = 0.75;
 
 // Below this margin between the best pose and the runner-up, the result is flagged ambiguous.
 constexpr double kAmbiguousMargin = 0.05;

@@ -1,0 +1,61 @@
+// The evidence a refined pose is judged on: its support and whether it lies on the target surface.
+#include "k4reg/pose_score.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include "k4reg/cloud_io.h"
+#include "k4reg/gt_pairs.h"
+#include "k4reg/voxel_grid.h"
+
+namespace k4reg {
+namespace {
+
+const std::string kBunny = std::string(K4REG_TEST_DATA_DIR) + "/bunny/";
+
+struct Scene {
+  IcpParams icp;
+  IcpPyramid source, target;
+  Eigen::Matrix4d truth;
+};
+
+Scene bunny(double sigma_m) {
+  GtPair pair;
+  for (const GtPair& p : read_gt_pairs(kBunny + "gt_pairs.log"))
+    if (p.source == "bun045.ply" && p.target == "bun000.ply") pair = p;
+  Scene s;
+  s.icp.voxel_m = sigma_m;
+  s.source = make_icp_pyramid(voxel_grid(read_cloud(kBunny + pair.source), sigma_m).cloud.points, s.icp, false);
+  s.target = make_icp_pyramid(voxel_grid(read_cloud(kBunny + pair.target), sigma_m).cloud.points, s.icp, true);
+  s.truth = pair.T_target_source;
+  return s;
+}
+
+// A true pose lies on the surface; turned 20 degrees about the truth, the clouds still cross and touch,
+// but what comes near the target surface no longer lies on it.
+TEST(PoseScore, TruePosesLieOnTheSurfaceWrongOnesOnlyTouchIt) {
+  const Scene s = bunny(0.002);
+  const PoseScorer scorer(s.source, s.target, nullptr, 0.5);
+  const Eigen::Matrix4d truth = refine_icp(s.source, s.target, s.truth, s.icp).transform;
+  EXPECT_GE(scorer.surface_agreement(truth), kMinSurfaceAgreement);
+  EXPECT_GT(scorer.score(truth), 0.8);
+
+  Eigen::Matrix4d off = Eigen::Matrix4d::Identity();
+  off.topLeftCorner<3, 3>() = Eigen::AngleAxisd(20.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Matrix4d wrong = off * s.truth;
+  EXPECT_LT(scorer.surface_agreement(wrong), 0.5);
+  EXPECT_LT(scorer.surface_agreement(wrong), scorer.surface_agreement(truth));
+}
+
+TEST(PoseScore, NothingNearGivesZero) {
+  const Scene s = bunny(0.002);
+  const PoseScorer scorer(s.source, s.target, nullptr, 0.5);
+  Eigen::Matrix4d far = s.truth;
+  far(0, 3) += 10.0;
+  EXPECT_EQ(scorer.surface_agreement(far), 0.0);
+  EXPECT_LE(scorer.score(far), 0.0);
+}
+
+}  // namespace
+}  // namespace k4reg
