@@ -8,7 +8,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <optional>
 
 #include "k4reg/dog_keypoints.h"
@@ -367,8 +366,9 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
     return result.hypotheses[a].refined_score > result.hypotheses[b].refined_score;
   });
   const std::size_t winner = kept[0];
+  const bool on_the_surface = on_surface(winner);
   // The runner-up is the next contender of the winner's kind; failing one, the best unrefined hypothesis.
-  const auto rival = std::find_if(kept.begin() + 1, kept.end(), [&](std::size_t i) { return on_surface(i) == on_surface(winner); });
+  const auto rival = std::find_if(kept.begin() + 1, kept.end(), [&](std::size_t i) { return on_surface(i) == on_the_surface; });
   const double winner_score = result.hypotheses[winner].refined_score;
   if (rival != kept.end())
     result.ambiguity_margin =
@@ -394,7 +394,6 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
 
   // The smallest overlap searched sets what a true pose must explain.
   const double needed = well_supported(overlaps[std::min(rounds_run, overlaps.size()) - 1]);
-  const bool on_the_surface = !params.icp || best.surface_agreement >= kMinSurfaceAgreement;
   if (!on_the_surface) {
     result.ambiguous = true;
     result.ambiguity_reason = fmt::format(
