@@ -66,6 +66,7 @@ void add_connection_flags(CLI::App& command, ConnectionOptions& options) {
   command
       .add_option("--server", options.server,
                   "HOST:PORT, a comma list IP:PORT,IP:PORT (round robin), or a gRPC target such as dns:///NAME:PORT")
+      ->envname("K4REG_SERVER")
       ->required()
       ->check([](const std::string& server) {
         try {
@@ -75,8 +76,10 @@ void add_connection_flags(CLI::App& command, ConnectionOptions& options) {
           return std::string(e.what());
         }
       });
-  command.add_flag("--tls", options.tls, "connect with TLS (server certificate checked against the system's roots)");
-  command.add_option("--ca-cert", options.ca_cert, "PEM file of the roots to trust instead; implies --tls");
+  command.add_flag("--tls", options.tls, "connect with TLS (server certificate checked against the system's roots)")
+      ->envname("K4REG_TLS");
+  command.add_option("--ca-cert", options.ca_cert, "PEM file of the roots to trust instead; implies --tls")
+      ->envname("K4REG_CA_CERT");
   command.add_option("--token", options.token, "bearer token for servers started with --auth-token")
       ->envname("K4REG_TOKEN");
 }

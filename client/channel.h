@@ -18,7 +18,7 @@ struct ConnectionOptions {
   std::string token;    // --token or $K4REG_TOKEN: sent as "authorization: Bearer <token>"
 };
 
-// --server (required), --tls, --ca-cert, --token.
+// --server (required; $K4REG_SERVER), --tls ($K4REG_TLS), --ca-cert ($K4REG_CA_CERT), --token ($K4REG_TOKEN).
 void add_connection_flags(CLI::App& command, ConnectionOptions& options);
 
 // The gRPC target for --server: "host:port" and "dns:///..."-style targets pass through; a comma list

@@ -1,5 +1,6 @@
 #include "health_command.h"
 
+#include <cstdlib>
 #include <iostream>
 #include <memory>
 
@@ -21,7 +22,35 @@ struct HealthOptions {
   double deadline_s = 2;                // a probe must answer quickly; a hung server counts as unhealthy
 };
 
-void run_health(const HealthOptions& o) {
+// The server's --health-listen address as seen from its own host: a wildcard host becomes loopback.
+std::string local_target(const std::string& listen) {
+  const auto colon = listen.rfind(':');
+  const std::string host = listen.substr(0, colon == std::string::npos ? 0 : colon);
+  const std::string port = colon == std::string::npos ? "" : listen.substr(colon + 1);
+  if (port.empty() || port == "0")
+    throw CommandError("K4REG_HEALTH_LISTEN=" + listen + " names no fixed port: give --server");
+  if (host == "0.0.0.0" || host.empty()) return "127.0.0.1:" + port;
+  if (host == "[::]") return "[::1]:" + port;
+  return listen;
+}
+
+// Without --server and $K4REG_SERVER: the health listener of a server started from the same environment
+// ($K4REG_HEALTH_LISTEN, as in the image), in plaintext since that listener never uses TLS. So the image's
+// HEALTHCHECK follows the container's settings, TLS or not, whatever the port.
+ConnectionOptions resolved(const ConnectionOptions& given) {
+  if (!given.server.empty()) return given;
+  const char* listen = std::getenv("K4REG_HEALTH_LISTEN");
+  if (!listen || !*listen) throw CommandError("no server: give --server, or set K4REG_SERVER or K4REG_HEALTH_LISTEN");
+  ConnectionOptions connection = given;
+  connection.server = local_target(listen);
+  connection.tls = false;
+  connection.ca_cert.clear();
+  return connection;
+}
+
+void run_health(const HealthOptions& options) {
+  HealthOptions o = options;
+  o.connection = resolved(options.connection);
   const std::shared_ptr<grpc::Channel> channel = make_channel(o.connection);
   auto stub = grpc::health::v1::Health::NewStub(channel);
   const std::vector<std::string> services = o.service_flag->count() > 0
@@ -51,6 +80,10 @@ void add_health_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "health", "check the server's liveness and readiness; exit code 0 when both are SERVING, 1 otherwise");
   add_connection_flags(*command, options->connection);
+  command->get_option("--server")
+      ->required(false)
+      ->description("HOST:PORT or a gRPC target (as for register); default: $K4REG_SERVER, else the local "
+                    "server's plaintext health listener from $K4REG_HEALTH_LISTEN");
   options->service_flag = command->add_option(
       "--service", options->service,
       "check this one name instead (liveness, readiness, k4reg.v1.Registration, \"\" = the server)");

@@ -1,19 +1,32 @@
 #!/usr/bin/env bash
-# Installs every Debian 12 package k4reg needs to build, test and benchmark.
-# Idempotent and non-interactive: packages already present are skipped.
+# Installs the Debian 12 packages k4reg needs. Idempotent and non-interactive: packages already present are skipped.
+#   install-deps.sh           everything: build, every test suite, sanitizers, fuzzing, benchmarks (CI, development)
+#   install-deps.sh --image   only what k4reg-server, k4reg and the unit tests need to compile (the image's build
+#                             stage, cmake -DK4REG_BUILD_BENCH=OFF): no PCL (VTK, Qt, MPI, a JDK), clang, prometheus
 set -euo pipefail
 
-PACKAGES=(
-  build-essential cmake pkg-config git ca-certificates
-  libeigen3-dev libpcl-dev libtbb-dev
+# The image's build stage; tests/docker/deployment_check.py reads this list (and its apt closure) from here.
+IMAGE_PACKAGES=(
+  build-essential cmake pkg-config
+  libeigen3-dev libtbb-dev libpugixml-dev
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc grpc-proto
-  libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libcpp-httplib-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libcpp-httplib-dev libssl-dev
+  libgtest-dev libgmock-dev
+)
+PACKAGES=(
+  "${IMAGE_PACKAGES[@]}" git ca-certificates
+  libpcl-dev libbenchmark-dev  # the benchmarks (bench/): PCL is the reference they compare with
   python3 python3-grpcio python3-protobuf
-  libpugixml-dev prometheus
-  gnuplot-nox yamllint python3-yaml docker-compose curl
+  prometheus
+  gnuplot-nox yamllint python3-yaml docker-compose curl openssl
   clang libclang-rt-14-dev llvm  # sanitizer and fuzz builds; llvm has llvm-symbolizer for their reports
 )
+
+case "${1:-}" in
+  --image) PACKAGES=("${IMAGE_PACKAGES[@]}") ;;
+  "") ;;
+  *) echo "usage: $0 [--image]" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${PACKAGES[@]}"; do

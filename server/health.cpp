@@ -2,11 +2,14 @@
 
 namespace k4reg::service {
 
-HealthPublisher::HealthPublisher(grpc::HealthCheckServiceInterface& health, const JobQueue& queue)
-    : health_(health), queue_(queue) {
-  for (const char* name : {"", kLivenessService, kReadinessService, kRegistrationService})
-    health_.SetServingStatus(name, true);
+HealthPublisher::HealthPublisher(std::vector<grpc::HealthCheckServiceInterface*> health, const JobQueue& queue)
+    : health_(std::move(health)), queue_(queue) {
+  for (const char* name : {"", kLivenessService, kReadinessService, kRegistrationService}) set(name, true);
   update();
+}
+
+void HealthPublisher::set(const char* name, bool serving) {
+  for (grpc::HealthCheckServiceInterface* health : health_) health->SetServingStatus(name, serving);
 }
 
 void HealthPublisher::update() {
@@ -14,14 +17,14 @@ void HealthPublisher::update() {
   const bool ready = !draining_ && !queue_.full();
   if (ready == ready_) return;
   ready_ = ready;
-  health_.SetServingStatus(kReadinessService, ready);
+  set(kReadinessService, ready);
 }
 
 void HealthPublisher::set_draining() {
   std::lock_guard lock(mutex_);
   draining_ = true;
   ready_ = false;
-  for (const char* name : {"", kReadinessService, kRegistrationService}) health_.SetServingStatus(name, false);
+  for (const char* name : {"", kReadinessService, kRegistrationService}) set(name, false);
 }
 
 }  // namespace k4reg::service

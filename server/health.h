@@ -8,6 +8,7 @@
 #include <grpcpp/health_check_service_interface.h>
 
 #include <mutex>
+#include <vector>
 
 #include "job_queue.h"
 
@@ -19,14 +20,17 @@ inline constexpr const char* kRegistrationService = "k4reg.v1.Registration";
 
 class HealthPublisher {
  public:
-  HealthPublisher(grpc::HealthCheckServiceInterface& health, const JobQueue& queue);
+  // Publishes the same statuses to every server's health service (the API's and the health listener's).
+  HealthPublisher(std::vector<grpc::HealthCheckServiceInterface*> health, const JobQueue& queue);
 
   // Re-reads the queue; call whenever it changes (cheap when nothing changed).
   void update();
   void set_draining();
 
  private:
-  grpc::HealthCheckServiceInterface& health_;
+  void set(const char* name, bool serving);
+
+  const std::vector<grpc::HealthCheckServiceInterface*> health_;
   const JobQueue& queue_;
   std::mutex mutex_;  // serialises updates so the last published state is the current one
   bool draining_ = false;

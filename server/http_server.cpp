@@ -3,6 +3,7 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "listen_address.h"
 #include "status_mapping.h"
 
 namespace k4reg::service {
@@ -25,18 +26,6 @@ std::string regex_escaped(std::string_view literal) {
   return pattern;
 }
 
-// "0.0.0.0:8080", "[::]:8080" -> host and port.
-std::pair<std::string, int> host_and_port(const std::string& listen) {
-  const auto colon = listen.rfind(':');
-  std::string host = listen.substr(0, colon == std::string::npos ? 0 : colon);
-  const std::string port = colon == std::string::npos ? "" : listen.substr(colon + 1);
-  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
-  if (host.empty() || port.empty() || port.size() > 5 || port.find_first_not_of("0123456789") != std::string::npos ||
-      std::stoi(port) > 65535)
-    throw std::runtime_error("--http-listen " + listen + ": expected host:port");
-  return {host, std::stoi(port)};
-}
-
 const HttpRoute* find_route(const std::string& method, const std::string& path) {
   for (const HttpRoute& route : http_routes())
     if (route.path == path && (route.method == method || (method == "HEAD" && route.method == "GET"))) return &route;
@@ -52,22 +41,39 @@ grpc::Status unmatched_status(const httplib::Request& request, std::string& allo
   return {grpc::StatusCode::UNIMPLEMENTED, request.method + " is not allowed on " + request.path + " (" + allowed + ")"};
 }
 
+// HTTPS with the gRPC listener's certificate and client verification when TLS is on (tls.h).
+std::unique_ptr<httplib::Server> make_server(const std::optional<TlsConfig>& tls) {
+  if (!tls) return std::make_unique<httplib::Server>();
+  // No exception may leave the callback (cpp-httplib would leak its context); load_tls ran the same checks.
+  auto server = std::make_unique<httplib::SSLServer>([&tls](SSL_CTX& context) {
+    try {
+      configure_ssl_context(context, *tls);
+      return true;
+    } catch (const std::runtime_error&) {
+      return false;
+    }
+  });
+  if (!server->is_valid()) throw std::runtime_error("cannot set up TLS for --http-listen");
+  return server;
+}
+
 }  // namespace
 
-HttpServer::HttpServer(const ServiceContext& service, const std::string& listen) : service_(service) {
+HttpServer::HttpServer(const ServiceContext& service, const std::string& listen, const std::optional<TlsConfig>& tls)
+    : service_(service), server_(make_server(tls)) {
   const std::size_t threads = service.queue.workers() + service.queue.capacity() + kSpareThreads;
-  server_.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
-  server_.set_keep_alive_timeout(kKeepAliveTimeoutS);
-  server_.set_keep_alive_max_count(100);
-  server_.set_read_timeout(kReadTimeoutS);
+  server_->new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+  server_->set_keep_alive_timeout(kKeepAliveTimeoutS);
+  server_->set_keep_alive_max_count(100);
+  server_->set_read_timeout(kReadTimeoutS);
   for (const HttpRoute& route : http_routes()) {
     const std::string pattern = regex_escaped(route.path);
     if (route.method == "GET")
-      server_.Get(pattern, [this, &route](const httplib::Request& request, httplib::Response& response) {
+      server_->Get(pattern, [this, &route](const httplib::Request& request, httplib::Response& response) {
         dispatch(route, request, response, nullptr);
       });
     else
-      server_.Post(pattern, [this, &route](const httplib::Request& request, httplib::Response& response,
+      server_->Post(pattern, [this, &route](const httplib::Request& request, httplib::Response& response,
                                            const httplib::ContentReader& content) {
         dispatch(route, request, response, &content);
       });
@@ -78,33 +84,33 @@ HttpServer::HttpServer(const ServiceContext& service, const std::string& listen)
   };
   const auto with_body = [this](const httplib::Request& request, httplib::Response& response,
                                 const httplib::ContentReader& content) { unmatched(request, response, &content); };
-  server_.Get(".*", without_body);
-  server_.Options(".*", without_body);
-  server_.Post(".*", with_body);
-  server_.Put(".*", with_body);
-  server_.Patch(".*", with_body);
-  server_.Delete(".*", with_body);
-  server_.set_expect_100_continue_handler(
+  server_->Get(".*", without_body);
+  server_->Options(".*", without_body);
+  server_->Post(".*", with_body);
+  server_->Put(".*", with_body);
+  server_->Patch(".*", with_body);
+  server_->Delete(".*", with_body);
+  server_->set_expect_100_continue_handler(
       [this](const httplib::Request& request, httplib::Response& response) { return expect_continue(request, response); });
-  server_.set_error_handler(httplib::Server::HandlerWithResponse(
+  server_->set_error_handler(httplib::Server::HandlerWithResponse(
       [this](const httplib::Request& request, httplib::Response& response) { return protocol_error(request, response); }));
 
-  const auto [host, port] = host_and_port(listen);
-  port_ = port == 0 ? server_.bind_to_any_port(host) : (server_.bind_to_port(host, port) ? port : -1);
+  const auto [host, port] = parse_listen_address(listen, "--http-listen");
+  port_ = port == 0 ? server_->bind_to_any_port(host) : (server_->bind_to_port(host, port) ? port : -1);
   if (port_ <= 0) throw std::runtime_error("cannot listen on " + listen + " (HTTP)");
 }
 
 HttpServer::~HttpServer() { stop(); }
 
 void HttpServer::start() {
-  thread_ = std::thread([this] { server_.listen_after_bind(); });
+  thread_ = std::thread([this] { server_->listen_after_bind(); });
   // stop() right after start() must find a running server to stop.
-  while (!server_.is_running()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  while (!server_->is_running()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
 }
 
 void HttpServer::stop() {
   stopping_ = true;
-  server_.stop();
+  server_->stop();
   if (thread_.joinable()) thread_.join();  // listen_after_bind returns once its pool has finished every connection
 }
 

@@ -9,18 +9,22 @@
 #include "http_lib.h"
 
 #include <atomic>
+#include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 
 #include "http_routes.h"
 #include "service_context.h"
+#include "tls.h"
 
 namespace k4reg::service {
 
 class HttpServer {
  public:
-  // Binds `listen`: "host:port", port 0 = ephemeral, "[::]:8080" for IPv6. Throws std::runtime_error.
-  HttpServer(const ServiceContext& service, const std::string& listen);
+  // Binds `listen`: "host:port", port 0 = ephemeral, "[::]:8080" for IPv6; HTTPS with `tls`. Throws
+  // std::runtime_error.
+  HttpServer(const ServiceContext& service, const std::string& listen, const std::optional<TlsConfig>& tls);
   ~HttpServer();  // stop()
   HttpServer(const HttpServer&) = delete;
   HttpServer& operator=(const HttpServer&) = delete;
@@ -46,7 +50,7 @@ class HttpServer {
 
   const ServiceContext& service_;
   std::atomic<bool> stopping_{false};
-  httplib::Server server_;
+  std::unique_ptr<httplib::Server> server_;  // an httplib::SSLServer with TLS
   int port_ = 0;
   std::thread thread_;
 };

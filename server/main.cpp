@@ -1,5 +1,6 @@
 // k4reg-server: the k4reg.v1.Registration gRPC service (see proto/k4reg/v1/registration.proto), with
-// grpc.health.v1 health and server reflection, and the same API over HTTP/JSON with /metrics (http_server.h).
+// grpc.health.v1 health and server reflection, and the same API over HTTP/JSON with /metrics (http_server.h);
+// TLS on both (tls.h); optionally a plaintext health-only listener for probes (health_listener.h).
 // Configuration: server_config.h (flags or K4REG_* variables).
 //
 // SIGTERM / SIGINT drain: readiness goes NOT_SERVING (HTTP /readyz 503), new calls get UNAVAILABLE (HTTP 503),
@@ -13,34 +14,20 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "health.h"
+#include "health_listener.h"
 #include "http_server.h"
 #include "json_log.h"
 #include "metrics.h"
 #include "registration_service.h"
 #include "server_config.h"
+#include "tls.h"
 
 namespace k4reg::service {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::string read_text_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read " + path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-std::shared_ptr<grpc::ServerCredentials> credentials(const ServerConfig& config) {
-  if (config.tls_cert.empty()) return grpc::InsecureServerCredentials();
-  grpc::SslServerCredentialsOptions options;
-  options.pem_key_cert_pairs.push_back({read_text_file(config.tls_key), read_text_file(config.tls_cert)});
-  return grpc::SslServerCredentials(options);
-}
 
 int milliseconds(double seconds) { return static_cast<int>(std::min(seconds * 1000.0, 2.0e9)); }
 
@@ -67,6 +54,7 @@ void write_port_file(const std::string& path, int port) {
 
 int serve(const ServerConfig& config, const sigset_t& stop_signals) {
   log_json(spdlog::level::info, "starting", {{"version", K4REG_VERSION}, {"config", config_to_json(config)}});
+  const std::optional<TlsConfig> tls = load_tls(config);
   const PathPolicy paths(config.data_roots);
   SpoolDir spool(config.spool_dir);
   MemoryBudget memory(config.memory_budget_mb << 20);
@@ -87,13 +75,16 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
                                metrics};
   RegistrationService service(context);
   std::unique_ptr<HttpServer> http;
-  if (!config.http_listen.empty()) http = std::make_unique<HttpServer>(context, config.http_listen);
+  if (!config.http_listen.empty()) http = std::make_unique<HttpServer>(context, config.http_listen, tls);
 
   grpc::EnableDefaultHealthCheckService(true);
+  // Before the reflection plugin: the health listener's gRPC server must carry the health service only.
+  std::unique_ptr<HealthListener> probes;
+  if (!config.health_listen.empty()) probes = std::make_unique<HealthListener>(context, config.health_listen);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
   int port = 0;
-  builder.AddListeningPort(config.grpc_listen, credentials(config), &port);
+  builder.AddListeningPort(config.grpc_listen, grpc_credentials(tls), &port);
   builder.RegisterService(&service);
   set_connection_options(builder, config);
   const std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
@@ -101,10 +92,16 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
     log_json(spdlog::level::critical, "cannot listen", {{"grpc_listen", config.grpc_listen}});
     return 1;
   }
-  HealthPublisher health(*server->GetHealthCheckService(), queue);
+  std::vector<grpc::HealthCheckServiceInterface*> health_services{server->GetHealthCheckService()};
+  if (probes) health_services.push_back(&probes->health());
+  HealthPublisher health(std::move(health_services), queue);
   queue.set_on_change([&health] { health.update(); });
   health.update();  // changes before the line above
-  nlohmann::json serving{{"grpc_port", port}, {"server_id", config.server_id}};
+  nlohmann::json serving{{"grpc_port", port}, {"server_id", config.server_id}, {"tls", tls.has_value()}};
+  if (probes) {
+    probes->start();
+    serving["health_port"] = probes->port();
+  }
   if (http) {
     http->start();
     serving["http_port"] = http->port();
@@ -131,6 +128,8 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
   // Replies already handed to gRPC get this long to leave; calls without a job (an unfinished upload) are
   // cut. Idle client connections that ignore GOAWAY also hold Shutdown until the deadline.
   server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
+  // Last: probes keep seeing the drain (readiness NOT_SERVING) until the API listeners are gone.
+  if (probes) probes->stop();
   queue.stop();
   log_json(spdlog::level::info, "stopped");
   return 0;

@@ -16,6 +16,10 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
                  "HTTP/JSON API and /metrics address host:port (port 0 = ephemeral, empty = no HTTP)")
       ->envname("K4REG_HTTP_LISTEN")
       ->capture_default_str();
+  app.add_option("--health-listen", c.health_listen,
+                 "plaintext listener for probes only (gRPC health, GET /healthz and /readyz), host:port; "
+                 "empty = none")
+      ->envname("K4REG_HEALTH_LISTEN");
   app.add_option("--port-file", c.port_file, "write the bound gRPC port to this file once serving")
       ->envname("K4REG_PORT_FILE");
   app.add_option("--http-port-file", c.http_port_file, "write the bound HTTP port to this file once serving")
@@ -46,12 +50,17 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--auth-token", c.auth_token, "require 'authorization: Bearer TOKEN' (health stays open)")
       ->envname("K4REG_AUTH_TOKEN");
-  auto* cert = app.add_option("--tls-cert", c.tls_cert, "PEM certificate chain (enables TLS)")
+  auto* cert = app.add_option("--tls-cert", c.tls_cert, "PEM certificate chain (enables TLS on gRPC and HTTP)")
                    ->envname("K4REG_TLS_CERT")
                    ->check(CLI::ExistingFile);
   auto* key = app.add_option("--tls-key", c.tls_key, "PEM private key")->envname("K4REG_TLS_KEY")->check(CLI::ExistingFile);
   cert->needs(key);
   key->needs(cert);
+  app.add_option("--tls-client-ca", c.tls_client_ca,
+                 "PEM CA certificates: gRPC and HTTP clients must present a certificate they signed (mutual TLS)")
+      ->envname("K4REG_TLS_CLIENT_CA")
+      ->check(CLI::ExistingFile)
+      ->needs(cert);
   app.add_option("--max-upload-mb", c.max_upload_mb, "largest streamed file, MiB")
       ->envname("K4REG_MAX_UPLOAD_MB")
       ->capture_default_str()
@@ -100,6 +109,7 @@ void finish_config(ServerConfig& c) {
 nlohmann::json config_to_json(const ServerConfig& c) {
   return {{"grpc_listen", c.grpc_listen},
           {"http_listen", c.http_listen},
+          {"health_listen", c.health_listen},
           {"port_file", c.port_file},
           {"http_port_file", c.http_port_file},
           {"data_roots", c.data_roots},
@@ -112,6 +122,7 @@ nlohmann::json config_to_json(const ServerConfig& c) {
           {"drain_grace_s", c.drain_grace_s},
           {"auth", !c.auth_token.empty()},
           {"tls", !c.tls_cert.empty()},
+          {"tls_client_ca", c.tls_client_ca},
           {"max_upload_mb", c.max_upload_mb},
           {"max_inline_mb", c.max_inline_mb},
           {"max_connection_age_s", c.max_connection_age_s},

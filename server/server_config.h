@@ -24,7 +24,9 @@ struct ServerConfig {
   std::string spool_dir;                      // parent of the per-process upload directory; "" = system temp
   double drain_grace_s = 25.0;                // after SIGTERM, running jobs get this long before cancellation
   std::string auth_token;                     // if set, calls need "authorization: Bearer <token>"
-  std::string tls_cert, tls_key;              // PEM files; both or neither
+  std::string tls_cert, tls_key;              // PEM files; both or neither; for gRPC and HTTP
+  std::string tls_client_ca;                  // PEM CA file: clients must present a certificate it signed
+  std::string health_listen;                  // plaintext health-only listener; "" = none
   std::size_t max_upload_mb = 4096;           // per streamed file
   std::size_t max_inline_mb = 32;             // per unary request (inline clouds), gRPC message limit
   double max_connection_age_s = 0;            // 0 = unlimited; otherwise GOAWAY after ~this long (rebalancing)

@@ -33,6 +33,12 @@ PATH_DIRS = ("/usr/local/bin/", "/usr/bin/", "/bin/")
 LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "[::1]")
 BUILD_TOOLS = re.compile(r"^(build-essential|gcc|g\+\+|cpp|clang|cmake|make|ninja-build)(-\d+)?$")
 VISUALIZATION = re.compile(r"vtk|pcl-visualization|qt")
+# What the image's build stage must not install, directly or through dependencies: PCL and its VTK/Qt/MPI
+# stack, a JDK, clang/LLVM, and the tools only CI or the benchmarks use.
+HEAVY_BUILD_PACKAGES = re.compile(r"^(libpcl|libvtk|libqt|qt\d|openjdk|default-jdk|default-jre|clang|libclang|llvm|"
+                                  r"libopenmpi|openmpi|mpi-default|prometheus|gnuplot|docker-compose|libbenchmark)")
+# The flags a HEALTHCHECK must leave to the environment (K4REG_HEALTH_LISTEN, or K4REG_SERVER / _TLS / _CA_CERT).
+HEALTHCHECK_FIXED_FLAGS = ("--server", "--tls", "--ca-cert")
 
 
 @dataclass
@@ -145,7 +151,31 @@ def served_ports(values):
     ports = {"grpc": listen_port(values.get("K4REG_GRPC_LISTEN", ""))}
     if values.get("K4REG_HTTP_LISTEN"):
         ports["http"] = listen_port(values["K4REG_HTTP_LISTEN"])
+    if values.get("K4REG_HEALTH_LISTEN"):
+        ports["health"] = listen_port(values["K4REG_HEALTH_LISTEN"])
     return ports
+
+
+def image_build_packages(repo):
+    """IMAGE_PACKAGES of scripts/install-deps.sh: what `install-deps.sh --image` installs."""
+    text = (Path(repo) / "scripts/install-deps.sh").read_text()
+    block = re.search(r"^IMAGE_PACKAGES=\((.*?)^\)", text, re.S | re.M)
+    if not block:
+        raise ValueError("scripts/install-deps.sh has no IMAGE_PACKAGES=( ... ) list")
+    return [w for line in block.group(1).splitlines() for w in line.split("#")[0].split()]
+
+
+@functools.lru_cache(maxsize=None)
+def apt_closure(packages):
+    """The packages `packages` pull in (Depends and PreDepends, no Recommends: install-deps.sh passes
+    --no-install-recommends), from apt's package lists; None without apt-cache."""
+    try:
+        done = subprocess.run(["apt-cache", "depends", "--recurse", "--no-recommends", "--no-suggests", "--no-conflicts",
+                               "--no-breaks", "--no-replaces", "--no-enhances", *packages],
+                              capture_output=True, text=True, timeout=120)
+    except FileNotFoundError:
+        return None
+    return {line.strip() for line in done.stdout.splitlines() if not line.startswith(" ") and not line.startswith("<")}
 
 
 # ---- the checks ------------------------------------------------------------------------------------------
@@ -222,8 +252,19 @@ def check_dockerfile(d, problems):
         problems.expect(re.match(r"debian:(12|bookworm)(\b|-)", stage.image), where, f"FROM {stage.image}: not Debian 12")
     build = stages[0]
     build_runs = " ".join(i.arguments for i in build.all("RUN"))
-    problems.expect("scripts/install-deps.sh" in build_runs, where, "the build stage must install with scripts/install-deps.sh")
+    problems.expect(any(args[:2] == ["scripts/install-deps.sh", "--image"] for args in shell_commands(build, "bash")),
+                    where, "the build stage must install with scripts/install-deps.sh --image")
     problems.expect("-DCMAKE_BUILD_TYPE=Release" in build_runs, where, "the build stage must configure Release")
+    problems.expect("-DK4REG_BUILD_BENCH=OFF" in build_runs, where, "the build stage must configure -DK4REG_BUILD_BENCH=OFF (no PCL)")
+    builds = [args for args in shell_commands(build, "cmake") if "--build" in args]
+    targets = {t for args in builds for i, word in enumerate(args[:-1]) if word == "--target" for t in args[i + 1 :]
+               if not t.startswith("-")}
+    problems.expect(builds and targets == {"k4reg-server", "k4reg", "k4reg-unit-tests"}, where,
+                    f"the build stage must build only --target k4reg-server k4reg k4reg-unit-tests, not {sorted(targets) or 'all'}")
+    image_packages = image_build_packages(d.repo)
+    closure = apt_closure(tuple(image_packages)) or set(image_packages)
+    for package in sorted(p for p in closure if HEAVY_BUILD_PACKAGES.match(p)):
+        problems.expect(False, where, f"install-deps.sh --image pulls in {package} (PCL/VTK/Qt/MPI, a JDK, clang or a CI tool)")
     problems.expect(re.search(r"ctest\b[^&;]*-L unit", build_runs), where, "the build stage must run the unit tests (ctest -L unit)")
 
     packages = apt_installed(runtime)
@@ -264,10 +305,12 @@ def check_dockerfile(d, problems):
         problems.expect(command[:2] == ["k4reg", "health"] and "k4reg" in on_path, where, f"HEALTHCHECK runs {command[:2]}, not k4reg health")
         for flag in cli_help.flags_of(command[2:]):
             problems.expect(flag in d.client_options["health"], where, f"HEALTHCHECK flag {flag} is not a k4reg health option")
-        server = command[command.index("--server") + 1] if "--server" in command[:-1] else ""
-        host, _, port = server.rpartition(":")
-        problems.expect(host in LOOPBACK_HOSTS and port == str(ports["grpc"]), where,
-                        f"HEALTHCHECK --server {server!r} must be the loopback gRPC port {ports['grpc']}")
+            problems.expect(flag not in HEALTHCHECK_FIXED_FLAGS, where,
+                            f"HEALTHCHECK {flag}: leave it to K4REG_HEALTH_LISTEN (or K4REG_SERVER, K4REG_TLS, K4REG_CA_CERT), "
+                            "so the check follows the container's TLS setting and ports")
+        health_host = values.get("K4REG_HEALTH_LISTEN", "").rpartition(":")[0]
+        problems.expect("health" in ports and health_host in ("0.0.0.0", "[::]", *LOOPBACK_HOSTS), where,
+                        "the image must set K4REG_HEALTH_LISTEN to a fixed port the HEALTHCHECK can reach on loopback")
         if "--service" in command[:-1]:
             service = command[command.index("--service") + 1]
             problems.expect(service in d.health_names.values(), where, f"HEALTHCHECK --service {service!r} is not in server/health.h")
@@ -277,6 +320,12 @@ def check_dockerfile(d, problems):
     if problems.expect(uid.isdigit() and uid != "0", where, f"USER must be a numeric non-root uid (Kubernetes runAsNonRoot), not {uid!r}"):
         problems.expect(any(uid in args[args.index("--uid") + 1 :][:1] for args in shell_commands(runtime, "useradd")
                             if "--uid" in args), where, f"no useradd creates uid {uid}")
+        gid = user.arguments.split(":")[1] if ":" in user.arguments else ""
+        group_ids = [args[args.index("--gid") + 1] for args in shell_commands(runtime, "groupadd") if "--gid" in args[:-1]]
+        user_gids = [args[args.index("--gid") + 1] for args in shell_commands(runtime, "useradd") if "--gid" in args[:-1]]
+        problems.expect(gid == uid and gid in group_ids and user_gids == [gid], where,
+                        f"USER {user.arguments}: the group must be {uid} too, created by groupadd --gid {uid} and given "
+                        f"to useradd --gid {uid} (groupadd: {group_ids}, useradd: {user_gids})")
     workdir = runtime.last("WORKDIR")
     created = {path for args in shell_commands(runtime, "mkdir") for path in args if not path.startswith("-")}
     for path in (values.get("K4REG_DATA_ROOT", "").split(":") + [values.get("K4REG_SPOOL_DIR", "")] +
@@ -402,7 +451,9 @@ def check_kubernetes(d, problems):
 
     for probe, name in (("livenessProbe", "kLivenessService"), ("readinessProbe", "kReadinessService")):
         grpc = container.get(probe, {}).get("grpc", {})
-        problems.expect(grpc.get("port") == ports["grpc"], where, f"{probe} must use the gRPC port {ports['grpc']}")
+        # Kubernetes' gRPC probes speak no TLS: they must go to the plaintext health-only listener.
+        problems.expect(grpc.get("port") == ports.get("health"), where,
+                        f"{probe} must use the health listener's port {ports.get('health')} (K4REG_HEALTH_LISTEN)")
         problems.expect(grpc.get("service") == d.health_names.get(name), where,
                         f"{probe} service {grpc.get('service')!r} must be {d.health_names.get(name)!r} (server/health.h)")
     check_stop_timeout(problems, where, pod["spec"].get("terminationGracePeriodSeconds", 30), values)

@@ -19,8 +19,10 @@ ARGS = None
 
 # (file under docker/, text to replace, replacement, words one of the reported problems must contain)
 BREAKAGES = [
-    ("Dockerfile", "EXPOSE 50051 8080", "EXPOSE 50052 8080", "EXPOSE [8080, 50052]"),
-    ("Dockerfile", "K4REG_GRPC_LISTEN=0.0.0.0:50051", "K4REG_GRPC_LISTEN=0.0.0.0:50052", "livenessProbe must use the gRPC port 50052"),
+    ("Dockerfile", "EXPOSE 50051 8080 8081", "EXPOSE 50052 8080 8081", "EXPOSE [8080, 8081, 50052]"),
+    ("Dockerfile", "K4REG_GRPC_LISTEN=0.0.0.0:50051", "K4REG_GRPC_LISTEN=0.0.0.0:50052", "EXPOSE [8080, 8081, 50051] but"),
+    ("Dockerfile", "    K4REG_HEALTH_LISTEN=0.0.0.0:8081 \\\n", "", "must set K4REG_HEALTH_LISTEN"),
+    ("Dockerfile", "K4REG_HEALTH_LISTEN=0.0.0.0:8081", "K4REG_HEALTH_LISTEN=0.0.0.0:8082", "livenessProbe must use the health listener's port 8082"),
     ("Dockerfile", 'ENTRYPOINT ["k4reg-server"]', "ENTRYPOINT k4reg-server", "ENTRYPOINT must be in exec form"),
     ("Dockerfile", 'ENTRYPOINT ["k4reg-server"]', 'ENTRYPOINT ["k4reg-server", "--grpc-port", "1"]', "--grpc-port is not a k4reg-server option"),
     ("Dockerfile", "USER 10001:10001", "USER k4reg", "USER must be a numeric non-root uid"),
@@ -29,15 +31,22 @@ BREAKAGES = [
     ("Dockerfile", "libtbb12 zlib1g", "libtbb12 libvtk9.1 zlib1g", "libvtk9.1 pulls in a GUI/VTK stack"),
     ("Dockerfile", "libstdc++6 libtbb12 zlib1g", "libstdc++6 zlib1g", "need libtbb12"),
     ("Dockerfile", "libstdc++6 libtbb12", "libstdc++6 curl libtbb12", "curl is not needed"),
-    ("Dockerfile", '"--server", "127.0.0.1:50051"]', '"--server", "127.0.0.1:50052"]', "HEALTHCHECK --server"),
-    ("Dockerfile", '"--server", "127.0.0.1:50051"]', '"--address", "127.0.0.1:50051"]', "--address is not a k4reg health option"),
+    ("Dockerfile", 'CMD ["k4reg", "health"]', 'CMD ["k4reg", "health", "--server", "127.0.0.1:50051"]', "HEALTHCHECK --server: leave it"),
+    ("Dockerfile", 'CMD ["k4reg", "health"]', 'CMD ["k4reg", "health", "--tls"]', "HEALTHCHECK --tls: leave it"),
+    ("Dockerfile", 'CMD ["k4reg", "health"]', 'CMD ["k4reg", "health", "--address", "127.0.0.1:8081"]', "--address is not a k4reg health option"),
+    ("Dockerfile", "groupadd --system --gid 10001 k4reg \\\n && useradd --system --uid 10001 --gid 10001",
+     "useradd --system --uid 10001 --user-group", "the group must be 10001 too"),
+    ("Dockerfile", "USER 10001:10001", "USER 10001:999", "the group must be 10001 too"),
     ("Dockerfile", 'CMD ["k4reg", "health"', 'CMD ["k4reg", "status"', "not k4reg health"),
     ("Dockerfile", "K4REG_SPOOL_DIR=/spool", "K4REG_SPOOL_DIRECTORY=/spool", "K4REG_SPOOL_DIRECTORY is not a k4reg-server variable"),
     ("Dockerfile", "mkdir -p /data /spool", "mkdir -p /data", "/spool is used but never created"),
     ("Dockerfile", "chown k4reg:k4reg /spool", "chown k4reg:k4reg /data", "owned by the server's user"),
     ("Dockerfile", "/src/build/bin/k4reg-server /src", "/src/build/bin/k4reg-serverd /src", "k4reg-serverd, which the build does not produce"),
     ("Dockerfile", "ctest --test-dir build -L unit", "ctest --test-dir build", "ctest -L unit"),
-    ("Dockerfile", "RUN bash scripts/install-deps.sh", "RUN apt-get update", "scripts/install-deps.sh"),
+    ("Dockerfile", "RUN bash scripts/install-deps.sh --image", "RUN bash scripts/install-deps.sh", "install-deps.sh --image"),
+    ("Dockerfile", " -DK4REG_BUILD_BENCH=OFF", "", "-DK4REG_BUILD_BENCH=OFF"),
+    ("Dockerfile", " --target k4reg-server k4reg k4reg-unit-tests", "", "must build only --target"),
+    ("../scripts/install-deps.sh", "  libgtest-dev libgmock-dev\n)", "  libgtest-dev libgmock-dev libpcl-dev\n)", "pulls in libvtk"),
     ("Dockerfile", "FROM debian:12-slim", "FROM ubuntu:24.04", "not Debian 12"),
     ("Dockerfile", "# k4reg-server image.", "# k4reg-server image (K4REG_THREADS).", "K4REG_THREADS is neither"),
     ("compose.yaml", "read_only: true", "read_only: false", "read-only bind mount"),
@@ -51,11 +60,13 @@ BREAKAGES = [
     ("compose.yaml", "      disable: true\n", "      interval: 10s\n", "disable the image's HEALTHCHECK"),
     ("compose.yaml", '      K4REG_WORKERS: "2"\n', "", "must set K4REG_WORKERS"),
     ("compose.yaml", "K4REG_SERVER_ID:", "K4REG_SERVERID:", "K4REG_SERVERID is not a k4reg-server variable"),
-    ("compose.yaml", '"127.0.0.1:8080:8080"', '"127.0.0.1:8080:8081"', "publishes [8081, 50051]"),
+    ("compose.yaml", '"127.0.0.1:8080:8080"', '"127.0.0.1:8080:8082"', "publishes [8082, 50051]"),
     ("compose.yaml", "dockerfile: docker/Dockerfile", "dockerfile: Dockerfile", "does not build docker/Dockerfile"),
     ("k8s/deployment.yaml", "service: readiness", "service: ready", "readinessProbe service 'ready'"),
-    ("k8s/deployment.yaml", "port: 50051\n              service: liveness", "port: 8080\n              service: liveness",
-     "livenessProbe must use the gRPC port"),
+    ("k8s/deployment.yaml", "port: 8081\n              service: liveness", "port: 50051\n              service: liveness",
+     "livenessProbe must use the health listener's port 8081"),
+    ("k8s/deployment.yaml", "port: 8081\n              service: readiness", "port: 50051\n              service: readiness",
+     "readinessProbe must use the health listener's port 8081"),
     ("k8s/deployment.yaml", "terminationGracePeriodSeconds: 90", "terminationGracePeriodSeconds: 60", "stop timeout 60 s"),
     ("k8s/deployment.yaml", '            - name: K4REG_MAX_CONNECTION_AGE_S\n              value: "300"\n', "", "K4REG_MAX_CONNECTION_AGE_S must be set"),
     ("k8s/deployment.yaml", "K4REG_QUEUE_SIZE", "K4REG_QUEUE_LENGTH", "K4REG_QUEUE_LENGTH is not a k4reg-server variable"),
@@ -82,11 +93,13 @@ BREAKAGES = [
 
 
 def mirror(repo, target):
-    """`target` as a stand-in for the repository: its own copy of docker/, links to everything else."""
+    """`target` as a stand-in for the repository: its own copies of docker/ and scripts/, links to everything else."""
+    copied = ("docker", "scripts")
     for entry in repo.iterdir():
-        if entry.name != "docker":
+        if entry.name not in copied:
             (target / entry.name).symlink_to(entry)
-    shutil.copytree(repo / "docker", target / "docker")
+    for name in copied:
+        shutil.copytree(repo / name, target / name)
     return target
 
 

@@ -2,12 +2,13 @@
 """The container's command line, run without a container: ENTRYPOINT + CMD + ENV of docker/Dockerfile
 (and the server environment compose.yaml and k8s/deployment.yaml add), with the binaries from the build
 and container paths mapped to host folders: the data root to tests/data/bunny, the spool and the WORKDIR
-to temporary folders. The one other change: listen ports become 0 (ephemeral, so tests can run in
-parallel); the host part stays, and the HEALTHCHECK's --server port follows the bound port.
+to temporary folders, host files (test certificates) as they are. The one other change: listen ports
+become 0 (ephemeral, so tests can run in parallel); the host part stays, and the HEALTHCHECK runs with the
+container's environment, K4REG_HEALTH_LISTEN naming the bound port.
 
 Checks the HEALTHCHECK command and HTTP /healthz and /readyz, a registration of the bunny pair, and the
 SIGTERM drain: a job running when the signal arrives completes within the drain grace, readiness turns
-NOT_SERVING (gRPC) and 503 (HTTP), exit code 0.
+NOT_SERVING (gRPC) and 503 (HTTP), exit code 0; and the HEALTHCHECK with TLS on and off.
 
     docker_entrypoint_test.py --repo REPO --bin-dir BUILD/bin"""
 
@@ -35,6 +36,16 @@ ARGS = None
 BUNNY = ["bun045.ply", "bun000.ply", "--ref", "--min-scale", "0.001", "--overlap", "0.9"]
 # ... and a job of a few seconds, well within the drain grace: many 4PCS bases (~1.6 ms each, one core).
 SLOW_BASES = "1500"
+LISTEN_VARIABLES = ("K4REG_GRPC_LISTEN", "K4REG_HTTP_LISTEN", "K4REG_HEALTH_LISTEN")
+
+
+def self_signed_certificate(folder):
+    """(cert, key) for localhost and 127.0.0.1, as README's TLS section makes one."""
+    cert, key = Path(folder) / "cert.pem", Path(folder) / "key.pem"
+    subprocess.run(["openssl", "req", "-x509", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1", "-nodes",
+                    "-days", "1", "-subj", "/CN=localhost", "-addext", "subjectAltName=DNS:localhost,IP:127.0.0.1",
+                    "-keyout", str(key), "-out", str(cert)], check=True, capture_output=True)
+    return cert, key
 
 
 def read_log(path):
@@ -75,11 +86,11 @@ class ContainerRun:
         self.container_values = values
         env = {k: v for k, v in os.environ.items() if not k.startswith("K4REG_")}
         for name, value in values.items():
-            if name in ("K4REG_GRPC_LISTEN", "K4REG_HTTP_LISTEN") and value:
+            if name in LISTEN_VARIABLES and value:
                 value = ephemeral(value)
             elif name == "K4REG_DATA_ROOT":
                 value = ":".join(str(self.host_path(r)) for r in self.data_roots)
-            elif value.startswith("/"):
+            elif value.startswith("/") and not Path(value).is_file():
                 value = str(self.host_path(value))
             elif value.startswith("<field:"):
                 value = "pod-" + value[len("<field:") : -1].replace(".", "-")
@@ -98,6 +109,7 @@ class ContainerRun:
         assert self.process.poll() is None, f"the server exited at start-up: {self.log_path.read_text()}"
         self.grpc_port = serving[0]["grpc_port"]
         self.http_port = serving[0].get("http_port")
+        self.health_port = serving[0].get("health_port")
 
     def host_path(self, container_path):
         """Data roots are the bunny scans; any other container folder becomes a fresh folder under `work`."""
@@ -110,20 +122,21 @@ class ContainerRun:
     def log(self, msg):
         return [line for line in read_log(self.log_path) if line.get("msg") == msg]
 
-    def healthcheck(self):
-        """The image's HEALTHCHECK command, its --server port replaced by the bound one."""
+    def healthcheck(self, **env):
+        """The image's HEALTHCHECK command in the container's environment (as Docker runs it), the health
+        listener at its bound port, plus `env`."""
         command = dockerfile.healthcheck(self.d.runtime)[1]
-        argv = [str(self.binaries[command[0]])] + [
-            re.sub(r":\d+$", f":{self.grpc_port}", word) if previous == "--server" else word
-            for previous, word in zip(command[:-1], command[1:])
-        ]
-        return subprocess.run(argv, capture_output=True, text=True, timeout=30)
+        environment = dict(self.env, **env)
+        if self.health_port:
+            environment["K4REG_HEALTH_LISTEN"] = re.sub(r":\d+$", f":{self.health_port}", environment["K4REG_HEALTH_LISTEN"])
+        argv = [str(self.binaries[command[0]])] + command[1:]
+        return subprocess.run(argv, capture_output=True, text=True, timeout=30, env=environment)
 
-    def http_get(self, path):
-        """(status code, body) of GET http://127.0.0.1:<bound HTTP port><path>."""
+    def http_get(self, path, port=None):
+        """(status code, body) of GET http://127.0.0.1:<port, default the bound HTTP port><path>."""
         direct = urllib.request.build_opener(urllib.request.ProxyHandler({}))  # never an http_proxy for loopback
         try:
-            with direct.open(f"http://127.0.0.1:{self.http_port}{path}", timeout=10) as reply:
+            with direct.open(f"http://127.0.0.1:{port or self.http_port}{path}", timeout=10) as reply:
                 return reply.status, reply.read().decode()
         except urllib.error.HTTPError as error:
             return error.code, error.read().decode()
@@ -216,6 +229,29 @@ class EntrypointTest(unittest.TestCase):
         self.assertTrue(server.log("stopped"))
         spool = server.host_path(server.container_values["K4REG_SPOOL_DIR"])
         self.assertEqual(list(spool.iterdir()), [], "the spool folder must be empty after exit")
+
+    def test_healthcheck_with_tls_on_and_off(self):
+        folder = tempfile.TemporaryDirectory()
+        self.addCleanup(folder.cleanup)
+        cert, key = self_signed_certificate(folder.name)
+        tls = {"K4REG_TLS_CERT": str(cert), "K4REG_TLS_KEY": str(key)}
+        for name, overrides in (("plaintext", {}), ("tls", tls), ("mutual tls", {**tls, "K4REG_TLS_CLIENT_CA": str(cert)})):
+            with self.subTest(configuration=name):
+                server = self.run_container(overrides)
+                health = server.healthcheck()
+                self.assertEqual(health.returncode, 0, health.stdout + health.stderr)
+                self.assertIn("readiness: SERVING", health.stdout)
+                self.assertEqual(server.http_get("/readyz", port=server.health_port)[0], 200)
+                plaintext = server.client("health")
+                plaintext.communicate(timeout=30)
+                self.assertEqual(plaintext.returncode, 1 if overrides else 0, "plaintext gRPC to the API port")
+                self.assertEqual(server.stop(), 0, server.log_path.read_text())
+        # Without the health listener the check follows K4REG_SERVER, K4REG_TLS and K4REG_CA_CERT instead.
+        server = self.run_container({**tls, "K4REG_HEALTH_LISTEN": ""})
+        self.assertIsNone(server.health_port)
+        health = server.healthcheck(K4REG_SERVER=f"localhost:{server.grpc_port}", K4REG_TLS="1", K4REG_CA_CERT=str(cert))
+        self.assertEqual(health.returncode, 0, health.stdout + health.stderr)
+        self.assertEqual(server.healthcheck(K4REG_SERVER=f"localhost:{server.grpc_port}").returncode, 1)
 
     def test_compose_and_kubernetes_settings_start_and_stop(self):
         for name, overrides in (("compose", deployment_check.compose_env(self.d)), ("k8s", deployment_check.k8s_env(self.d))):
