@@ -12,7 +12,9 @@
 #include "k4reg/four_pcs.h"
 #include "k4reg/icp.h"
 #include "k4reg/neighbor_grid.h"
+#include "k4reg/normal_space_sampling.h"
 #include "k4reg/rigid_fit.h"
+#include "k4reg/translation_vote.h"
 
 namespace k4reg {
 namespace {
@@ -43,18 +45,28 @@ Eigen::Vector3f trimmed_centre(const std::vector<Eigen::Vector3f>& points) {
   return centre;
 }
 
-// Half-turns about the target's principal axes through its centre: a rectangular room's shell looks
-// the same after a half turn about the vertical (and nearly so about the other two axes), so a pose
-// composed with one of them is where 4PCS's symmetric twin of the true pose lies. As target -> target maps.
-std::vector<Eigen::Matrix4d> principal_half_turns(const std::vector<Eigen::Vector3f>& points) {
-  if (points.size() < 10) return {};
-  const Eigen::Vector3d centre = trimmed_centre(points).cast<double>();
+// The principal axes of the points about their centre, and of the normals (the eigenvectors of
+// sum n n^T): a rectangular room's or a plaza's main surfaces lie along the second set whatever the
+// scan's extent, while the first tilts by degrees where the ground reaches further on one side.
+Eigen::Matrix3d point_axes(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3d& centre) {
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   for (const Eigen::Vector3f& p : points) cov += (p.cast<double>() - centre) * (p.cast<double>() - centre).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
+}
+
+Eigen::Matrix3d normal_axes(const std::vector<Eigen::Vector3f>& normals) {
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3f& n : normals) scatter += n.cast<double>() * n.cast<double>().transpose();
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors();
+}
+
+// Half-turns about the columns of `axes` through `centre`: a rectangular room's shell looks the same
+// after a half turn about the vertical (and nearly so about the other two axes), so a pose composed with
+// one of them is where 4PCS's symmetric twin of the true pose lies. As target -> target maps.
+std::vector<Eigen::Matrix4d> half_turns(const Eigen::Matrix3d& axes, const Eigen::Vector3d& centre) {
   std::vector<Eigen::Matrix4d> turns;
   for (int axis = 0; axis < 3; ++axis) {
-    const Eigen::Matrix3d r = Eigen::AngleAxisd(M_PI, solver.eigenvectors().col(axis).normalized()).toRotationMatrix();
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(M_PI, axes.col(axis).normalized()).toRotationMatrix();
     Eigen::Matrix4d s = Eigen::Matrix4d::Identity();
     s.topLeftCorner<3, 3>() = r;
     s.topRightCorner<3, 1>() = centre - r * centre;
@@ -63,16 +75,22 @@ std::vector<Eigen::Matrix4d> principal_half_turns(const std::vector<Eigen::Vecto
   return turns;
 }
 
+// Every k-th point, at most max_points of them.
+std::vector<Eigen::Vector3f> every_kth(const std::vector<Eigen::Vector3f>& points, std::size_t max_points) {
+  const std::size_t step = std::max<std::size_t>(1, (points.size() + max_points - 1) / max_points);
+  std::vector<Eigen::Vector3f> out;
+  for (std::size_t i = 0; i < points.size(); i += step) out.push_back(points[i]);
+  return out;
+}
+
 // Every k-th point of each stage, at most max_points: settling a pose needs thousands of well-spread
 // correspondences, not the tens of thousands of the scored stage (ICP's cost is linear in them).
 IcpPyramid thinned(const IcpPyramid& pyramid, std::size_t max_points) {
   IcpPyramid thin;
   thin.stages.resize(pyramid.stages.size());
   for (std::size_t s = 0; s < pyramid.stages.size(); ++s) {
-    const auto& points = pyramid.stages[s].points;
-    const std::size_t step = (points.size() + max_points - 1) / max_points;
     thin.stages[s].voxel_m = pyramid.stages[s].voxel_m;
-    for (std::size_t i = 0; i < points.size(); i += std::max<std::size_t>(step, 1)) thin.stages[s].points.push_back(points[i]);
+    thin.stages[s].points = every_kth(pyramid.stages[s].points, max_points);
   }
   return thin;
 }
@@ -175,10 +193,30 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   settle_all(hypotheses);
   std::stable_sort(hypotheses.begin(), hypotheses.end(), by_score);
   // 4PCS on a symmetric room often finds only the flipped pose; its symmetric twin must compete too.
-  if (!hypotheses.empty()) {
+  // Turned about the principal axes through the target's centre, or about the normals' axes and then
+  // shifted to where the vote puts it: the symmetric structure need not stand at the centre of its scan.
+  const auto& coarse_source = source.stages.front();
+  const auto& coarse_target = target.stages.front();
+  if (!hypotheses.empty() && coarse_target.points.size() >= 10) {
+    constexpr std::size_t kVoters = 1500, kShifts = 2;
+    const NeighborGrid source_grid(coarse_source.points, 2.5 * coarse_source.voxel_m);
+    const std::vector<Eigen::Vector3f> voting_source = normal_space_sample(
+        coarse_source.points, estimate_normals(coarse_source.points, source_grid, 2.5 * coarse_source.voxel_m), kVoters);
+    const std::vector<Eigen::Vector3f> voting_target =
+        normal_space_sample(coarse_target.points, coarse_target.normals, kVoters);
+    const Eigen::Vector3d centre = trimmed_centre(coarse_target.points).cast<double>();
+    const Eigen::Matrix4d& best = hypotheses.front().transform;
     std::vector<Hypothesis> twins;
-    for (const Eigen::Matrix4d& s : principal_half_turns(target.stages.front().points))
-      twins.push_back({s * hypotheses.front().transform, 0.0, 0.0});
+    for (const Eigen::Matrix4d& s : half_turns(point_axes(coarse_target.points, centre), centre))
+      twins.push_back({s * best, 0.0, 0.0});
+    for (const Eigen::Matrix4d& s : half_turns(normal_axes(coarse_target.normals), centre)) {
+      Eigen::Matrix4d turned = s * best;
+      for (const Eigen::Vector3d& shift : vote_translations(voting_source, voting_target, turned.topLeftCorner<3, 3>(),
+                                                            2.0 * coarse_target.voxel_m, kShifts)) {
+        turned.topRightCorner<3, 1>() = shift;
+        twins.push_back({turned, 0.0, 0.0});
+      }
+    }
     settle_all(twins);
     hypotheses.insert(hypotheses.end(), twins.begin(), twins.end());
     std::stable_sort(hypotheses.begin(), hypotheses.end(), by_score);

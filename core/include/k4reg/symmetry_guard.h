@@ -4,9 +4,10 @@
 // covers, less how much of it lands in space the target scanner saw to be empty (points the target
 // scanner could not see, or saw from the other side of their surface, are no evidence). 4PCS on a
 // symmetric room often finds only the flipped pose, so the best hypothesis's twins under half turns
-// about the target's principal axes compete too.
-// Cost per hypothesis (and per each of three twins): a few ICP iterations on a few thousand points
-// from two starts and up to two passes over the coarse source.
+// compete too: about the target's principal axes through its centre, and about the axes of its normals,
+// shifted to where a translation vote on normal-space samples puts them (translation_vote.h).
+// Cost per hypothesis (and per each of nine twins): a few ICP iterations on a few thousand points
+// from two starts and up to two passes over the coarse source; per vote, 1500 x 1500 votes.
 #pragma once
 
 #include <vector>

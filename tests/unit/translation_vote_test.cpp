@@ -1,0 +1,51 @@
+// The translation vote: for a known rotation, the shift where structure meets structure.
+#include "k4reg/translation_vote.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+namespace k4reg {
+namespace {
+
+// A box of 1 m standing at `at` on nothing else: points on its faces every 0.1 m.
+std::vector<Eigen::Vector3f> box(const Eigen::Vector3f& at) {
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i <= 10; ++i)
+    for (int j = 0; j <= 10; ++j)
+      for (int face = 0; face < 3; ++face) {
+        Eigen::Vector3f p(i * 0.1f, j * 0.1f, 0.0f), q = p;
+        std::swap(q(face), q(2));
+        points.push_back(at + q);
+        q(face) = 1.0f;
+        points.push_back(at + q);
+      }
+  return points;
+}
+
+TEST(TranslationVote, FindsTheShiftOfARotatedObject) {
+  const std::vector<Eigen::Vector3f> target = box({4, -2, 1});
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::Vector3d shift(1.5, -0.5, 2.0);
+  std::vector<Eigen::Vector3f> source;  // target = r * source + shift
+  for (const Eigen::Vector3f& q : target) source.push_back((r.transpose() * (q.cast<double>() - shift)).cast<float>());
+  const auto shifts = vote_translations(source, target, r, 0.2, 3);
+  ASSERT_EQ(shifts.size(), 3u);
+  // The winner is the cell whose 3 x 3 x 3 block has the most votes: within about a cell on each axis.
+  EXPECT_LT((shifts[0] - shift).cwiseAbs().maxCoeff(), 0.25);
+  // The runner-ups are more than a cell away from the winner.
+  for (std::size_t i = 1; i < shifts.size(); ++i) EXPECT_GT((shifts[i] - shifts[0]).cwiseAbs().maxCoeff(), 0.2);
+}
+
+TEST(TranslationVote, IsDeterministicAndEmptyForNoPoints) {
+  const std::vector<Eigen::Vector3f> target = box({0, 0, 0});
+  const auto a = vote_translations(target, target, Eigen::Matrix3d::Identity(), 0.25, 4);
+  const auto b = vote_translations(target, target, Eigen::Matrix3d::Identity(), 0.25, 4);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i], b[i]);
+  EXPECT_LT(a[0].norm(), 0.25);
+  EXPECT_TRUE(vote_translations({}, target, Eigen::Matrix3d::Identity(), 0.25, 4).empty());
+}
+
+}  // namespace
+}  // namespace k4reg
