@@ -54,13 +54,14 @@ std::vector<Eigen::Vector3d> vote_translations(const std::vector<Eigen::Vector3f
   std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
   std::vector<Eigen::Vector3d> shifts;
   std::vector<Eigen::Vector3i> taken;
-  for (const auto& [sum, cell] : ranked) {
+  for (const auto& entry : ranked) {
     if (shifts.size() == peaks) break;
+    const Eigen::Vector3i& head = indices[entry.second];
     if (std::any_of(taken.begin(), taken.end(),
-                    [&](const Eigen::Vector3i& t) { return (t - indices[cell]).cwiseAbs().maxCoeff() <= 1; }))
+                    [&](const Eigen::Vector3i& t) { return (t - head).cwiseAbs().maxCoeff() <= 1; }))
       continue;
-    taken.push_back(indices[cell]);
-    shifts.push_back((indices[cell].cast<double>() + Eigen::Vector3d::Constant(0.5)) * cell_m);
+    taken.push_back(head);
+    shifts.push_back((head.cast<double>() + Eigen::Vector3d::Constant(0.5)) * cell_m);
   }
   return shifts;
 }
