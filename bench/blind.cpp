@@ -25,10 +25,10 @@
 #include <string>
 #include <vector>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/error.h"
-#include "k4reg/gt_pairs.h"
-#include "k4reg/registration.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/util/error.h"
+#include "k4reg/io/gt_pairs.h"
+#include "k4reg/registration/registration.h"
 #include "markdown_block.h"
 #include "simulated_scan_cache.h"
 #include "statistics.h"

@@ -32,7 +32,7 @@
 #include "compare_job.h"
 #include "compare_journal.h"
 #include "compare_report.h"
-#include "k4reg/gt_pairs.h"
+#include "k4reg/io/gt_pairs.h"
 #include "machine_load.h"
 #include "markdown_block.h"
 #include "sift_cache.h"

@@ -21,15 +21,15 @@
 #include <random>
 
 #include "compare_job.h"
-#include "k4reg/cloud_io.h"
-#include "k4reg/dog_keypoints.h"
-#include "k4reg/error.h"
-#include "k4reg/four_pcs.h"
-#include "k4reg/metrics.h"
-#include "k4reg/neighbor_grid.h"
-#include "k4reg/registration.h"
-#include "k4reg/surface_signal.h"
-#include "k4reg/voxel_grid.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/registration/dog_keypoints.h"
+#include "k4reg/util/error.h"
+#include "k4reg/registration/four_pcs.h"
+#include "k4reg/registration/metrics.h"
+#include "k4reg/geometry/neighbor_grid.h"
+#include "k4reg/registration/registration.h"
+#include "k4reg/registration/surface_signal.h"
+#include "k4reg/geometry/voxel_grid.h"
 #include "pcl_methods.h"
 #include "sift_cache.h"
 #include "truth_error.h"
@@ -298,7 +298,7 @@ void run_match(const Job& job, const LoadedPair& pair, json& out) {
   out["final"] = e;
 }
 
-// Our detector exactly as register_clouds runs it (core/src/registration.cpp, steps 1 and 2).
+// Our detector exactly as register_clouds runs it (core/src/registration/registration.cpp, steps 1 and 2).
 std::vector<Eigen::Vector3f> our_keypoints(const PointCloud& cloud, bool use_intensity, double sigma_m) {
   const VoxelizedCloud voxels = voxel_grid(cloud, sigma_m);
   const RegistrationParams defaults;

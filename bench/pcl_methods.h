@@ -12,7 +12,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "k4reg/point_cloud.h"
+#include "k4reg/geometry/point_cloud.h"
 
 namespace k4reg::bench {
 

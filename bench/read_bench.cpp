@@ -16,11 +16,11 @@
 #include <string>
 #include <vector>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/e57_io.h"
-#include "k4reg/las_io.h"
-#include "k4reg/ply_io.h"
-#include "k4reg/ptx_io.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/io/e57_io.h"
+#include "k4reg/io/las_io.h"
+#include "k4reg/io/ply_io.h"
+#include "k4reg/io/ptx_io.h"
 
 namespace fs = std::filesystem;
 

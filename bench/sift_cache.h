@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "k4reg/point_cloud.h"
+#include "k4reg/geometry/point_cloud.h"
 #include "pcl_methods.h"
 
 namespace k4reg::bench {

@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/matrix_file.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/io/matrix_file.h"
 #include "sim/scanner.h"
 #include "sim/scene.h"
 

@@ -31,10 +31,10 @@
 #include <thread>
 #include <vector>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/error.h"
-#include "k4reg/metrics.h"
-#include "k4reg/registration.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/util/error.h"
+#include "k4reg/registration/metrics.h"
+#include "k4reg/registration/registration.h"
 #include "markdown_block.h"
 #include "paper_tables.h"
 #include "sim/scene.h"
@@ -56,7 +56,7 @@ constexpr double kOverlap = 0.8;  // the paper's setting for the indoor suite
 constexpr std::array<std::size_t, 3> kFullSizes = {700000, 2500000, 10000000};
 constexpr std::array<double, 3> kFullSigmas_m = {0.025, 0.05, 0.1};
 constexpr int kFullSeeds = 10;
-// register_clouds' stages, in pipeline order (core/src/registration.cpp).
+// register_clouds' stages, in pipeline order (core/src/registration/registration.cpp).
 constexpr std::array<const char*, 6> kStages = {"voxel_grid", "keypoints", "matching",
                                                 "icp_setup",  "symmetry_guard", "icp"};
 

@@ -4,8 +4,8 @@
 
 #include <Eigen/Core>
 
-#include "k4reg/metrics.h"
-#include "k4reg/point_cloud.h"
+#include "k4reg/registration/metrics.h"
+#include "k4reg/geometry/point_cloud.h"
 
 namespace k4reg::bench {
 

@@ -8,7 +8,7 @@
 #include <pcl/filters/voxel_grid.h>
 #include <tbb/task_arena.h>
 
-#include "k4reg/voxel_grid.h"
+#include "k4reg/geometry/voxel_grid.h"
 #include "pcl_methods.h"
 #include "sim/scanner.h"
 #include "sim/scene.h"

@@ -4,9 +4,9 @@
 #include <iostream>
 #include <memory>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/matrix_file.h"
-#include "k4reg/metrics.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/io/matrix_file.h"
+#include "k4reg/registration/metrics.h"
 #include "registration_flags.h"
 #include "result_report.h"
 

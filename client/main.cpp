@@ -4,8 +4,9 @@
 #include <iostream>
 
 #include "align_command.h"
+#include "align_project_command.h"
 #include "command_error.h"
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 #ifdef K4REG_REMOTE_COMMANDS
 #include "health_command.h"
 #include "load_command.h"
@@ -16,6 +17,7 @@ int main(int argc, char** argv) {
   CLI::App app{"k4reg: markerless registration of laser scans (K-4PCS)"};
   app.require_subcommand(1);
   k4reg::cli::add_align_command(app);
+  k4reg::cli::add_align_project_command(app);
 #ifdef K4REG_REMOTE_COMMANDS
   k4reg::cli::add_register_command(app);
   k4reg::cli::add_health_command(app);

@@ -3,7 +3,7 @@
 // service library.
 #pragma once
 
-#include "k4reg/registration.h"
+#include "k4reg/registration/registration.h"
 #include "k4reg/v1/registration.pb.h"
 #include "registration_flags.h"
 

@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "channel.h"
-#include "k4reg/matrix_file.h"
+#include "k4reg/io/matrix_file.h"
 #include "progress_bar.h"
 #include "proto_mapping.h"
 #include "registration_flags.h"

@@ -4,7 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "k4reg/registration.h"
+#include "k4reg/registration/registration.h"
 
 namespace k4reg::cli {
 

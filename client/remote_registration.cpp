@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "command_error.h"
-#include "k4reg/crc32c.h"
+#include "k4reg/util/crc32c.h"
 #include "local_file.h"
 #include "status_text.h"
 

@@ -2,10 +2,9 @@
 
 #include <fmt/format.h>
 
-#include "k4reg/matrix_file.h"
+#include "k4reg/io/matrix_file.h"
 
 namespace k4reg::cli {
-namespace {
 
 nlohmann::json matrix_to_json(const Eigen::Matrix4d& m) {
   nlohmann::json rows = nlohmann::json::array();
@@ -13,8 +12,6 @@ nlohmann::json matrix_to_json(const Eigen::Matrix4d& m) {
     for (int c = 0; c < 4; ++c) rows.push_back(m(r, c));
   return rows;  // row-major, 16 numbers
 }
-
-}  // namespace
 
 nlohmann::json result_to_json(const RegistrationResult& r) {
   nlohmann::json j;
@@ -46,9 +43,23 @@ nlohmann::json result_to_json(const RegistrationResult& r) {
          {"cloud_score", h.cloud_score},
          {"refined_score", h.refined_score},
          {"surface_agreement", h.surface_agreement}});
-  j["timings"] = nlohmann::json::array();
-  for (const StageTiming& t : r.timings) j["timings"].push_back({{"stage", t.stage}, {"seconds", t.seconds}});
+  j["timings"] = timings_to_json(r.timings);
   return j;
+}
+
+nlohmann::json timings_to_json(const std::vector<StageTiming>& timings) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const StageTiming& t : timings) j.push_back({{"stage", t.stage}, {"seconds", t.seconds}});
+  return j;
+}
+
+void print_timings(std::ostream& out, const std::vector<StageTiming>& timings) {
+  double total = 0;
+  for (const StageTiming& t : timings) {
+    out << fmt::format("  {:<20}{:.3f} s\n", t.stage, t.seconds);
+    total += t.seconds;
+  }
+  out << fmt::format("{:<22}{:.3f} s\n", "total", total);
 }
 
 void print_result_table(std::ostream& out, const RegistrationResult& r) {
@@ -71,12 +82,7 @@ void print_result_table(std::ostream& out, const RegistrationResult& r) {
     out << "\n";
   }
   out << fmt::format("{:<22}{}\n", "seed", r.seed);
-  double total = 0;
-  for (const StageTiming& t : r.timings) {
-    out << fmt::format("  {:<20}{:.3f} s\n", t.stage, t.seconds);
-    total += t.seconds;
-  }
-  out << fmt::format("{:<22}{:.3f} s\n", "total", total);
+  print_timings(out, r.timings);
 }
 
 nlohmann::json error_to_json(const TransformError& e, bool success) {

@@ -5,12 +5,18 @@
 #include <optional>
 #include <ostream>
 
-#include "k4reg/metrics.h"
-#include "k4reg/registration.h"
+#include "k4reg/registration/metrics.h"
+#include "k4reg/registration/registration.h"
 
 namespace k4reg::cli {
 
+// A 4x4 matrix as 16 numbers, row-major (the API's layout).
+nlohmann::json matrix_to_json(const Eigen::Matrix4d& m);
+
 nlohmann::json result_to_json(const RegistrationResult& result);
+// Stage timings: [{"stage", "seconds"}], and as indented lines with their total.
+nlohmann::json timings_to_json(const std::vector<StageTiming>& timings);
+void print_timings(std::ostream& out, const std::vector<StageTiming>& timings);
 void print_result_table(std::ostream& out, const RegistrationResult& result);
 
 nlohmann::json error_to_json(const TransformError& error, bool success);

@@ -9,6 +9,7 @@
 # all), K4REG_FUZZ_BUILD_DIR (default build-fuzz).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/compiler-cache.sh
 build=${K4REG_FUZZ_BUILD_DIR:-build-fuzz}
 seconds=${K4REG_FUZZ_SECONDS:-45}
 

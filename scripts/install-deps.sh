@@ -18,7 +18,7 @@ PACKAGES=(
   libpcl-dev libbenchmark-dev  # the benchmarks (bench/): PCL is the reference they compare with
   python3 python3-grpcio python3-protobuf
   prometheus
-  gnuplot-nox yamllint python3-yaml docker-compose curl openssl
+  gnuplot-nox yamllint python3-yaml docker-compose curl openssl ccache
   clang libclang-rt-14-dev llvm  # sanitizer and fuzz builds; llvm has llvm-symbolizer for their reports
 )
 

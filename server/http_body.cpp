@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cctype>
 
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 
 namespace k4reg::service {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 #include "status_name.h"
 
 namespace k4reg::service {

@@ -7,7 +7,7 @@
 
 #include "http_json.h"
 #include "http_upload.h"
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 #include "proto_convert.h"
 #include "status_mapping.h"
 

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "http_json.h"
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 
 namespace k4reg::service {
 namespace {

@@ -13,7 +13,7 @@
 #include <thread>
 #include <vector>
 
-#include "k4reg/cancellation.h"
+#include "k4reg/util/cancellation.h"
 
 namespace k4reg::service {
 

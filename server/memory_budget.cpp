@@ -3,7 +3,7 @@
 #include <chrono>
 #include <string>
 
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 
 namespace k4reg::service {
 

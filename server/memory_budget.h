@@ -11,7 +11,7 @@
 #include <cstddef>
 #include <mutex>
 
-#include "k4reg/cancellation.h"
+#include "k4reg/util/cancellation.h"
 
 namespace k4reg::service {
 

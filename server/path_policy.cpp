@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 
 namespace k4reg::service {
 namespace fs = std::filesystem;

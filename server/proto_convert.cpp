@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 
 namespace k4reg::service {
 namespace {

@@ -1,7 +1,7 @@
 // k4reg.v1 messages <-> core structs. Shared by the gRPC service and the HTTP/JSON API.
 #pragma once
 
-#include "k4reg/registration.h"
+#include "k4reg/registration/registration.h"
 #include "k4reg/v1/registration.pb.h"
 
 namespace k4reg::service {

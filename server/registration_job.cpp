@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/error.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/util/error.h"
 
 namespace k4reg::service {
 namespace {

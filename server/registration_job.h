@@ -7,8 +7,8 @@
 #include <string>
 #include <string_view>
 
-#include "k4reg/cancellation.h"
-#include "k4reg/registration.h"
+#include "k4reg/util/cancellation.h"
+#include "k4reg/registration/registration.h"
 #include "k4reg/v1/registration.pb.h"
 #include "memory_budget.h"
 

@@ -1,7 +1,7 @@
 #include "service_context.h"
 
 #include "auth.h"
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 #include "proto_convert.h"
 #include "status_mapping.h"
 #include "status_name.h"

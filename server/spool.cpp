@@ -9,7 +9,7 @@
 #include <cerrno>
 #include <cstring>
 
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 
 namespace k4reg::service {
 namespace fs = std::filesystem;

@@ -10,7 +10,7 @@
 #include <string>
 #include <string_view>
 
-#include "k4reg/crc32c.h"
+#include "k4reg/util/crc32c.h"
 
 namespace k4reg::service {
 

@@ -4,7 +4,7 @@
 
 #include <grpcpp/support/status.h>
 
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 
 namespace k4reg::service {
 

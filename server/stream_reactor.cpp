@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 #include "proto_convert.h"
 #include "status_mapping.h"
 

@@ -8,9 +8,9 @@
 #include <numbers>
 #include <string>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/error.h"
-#include "k4reg/matrix_file.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/util/error.h"
+#include "k4reg/io/matrix_file.h"
 #include "sim/scanner.h"
 #include "sim/scene.h"
 

@@ -6,7 +6,7 @@
 #include <string_view>
 
 #include "fuzz_checks.h"
-#include "k4reg/cloud_io.h"
+#include "k4reg/io/cloud_io.h"
 
 namespace {
 

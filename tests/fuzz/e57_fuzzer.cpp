@@ -7,8 +7,8 @@
 #include <string>
 
 #include "fuzz_checks.h"
-#include "k4reg/crc32c.h"
-#include "k4reg/e57_io.h"
+#include "k4reg/util/crc32c.h"
+#include "k4reg/io/e57_io.h"
 
 namespace {
 

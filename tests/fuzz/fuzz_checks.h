@@ -9,8 +9,8 @@
 #include <exception>
 #include <string>
 
-#include "k4reg/error.h"
-#include "k4reg/point_cloud.h"
+#include "k4reg/util/error.h"
+#include "k4reg/geometry/point_cloud.h"
 
 namespace k4reg::fuzz {
 

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "fuzz_checks.h"
-#include "k4reg/cloud_io.h"
+#include "k4reg/io/cloud_io.h"
 #include "k4reg/v1/registration.pb.h"
 #include "proto_convert.h"
 

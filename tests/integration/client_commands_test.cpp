@@ -13,8 +13,8 @@
 #include <sstream>
 #include <thread>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/e57_io.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/io/e57_io.h"
 #include "test_support.h"
 
 extern char** environ;

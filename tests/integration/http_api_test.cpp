@@ -12,7 +12,7 @@
 
 #include "http_json.h"
 #include "http_routes.h"
-#include "k4reg/metrics.h"
+#include "k4reg/registration/metrics.h"
 #include "test_support.h"
 
 namespace k4reg::test {

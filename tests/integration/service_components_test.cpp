@@ -8,9 +8,9 @@
 #include <future>
 #include <thread>
 
-#include "k4reg/crc32c.h"
+#include "k4reg/util/crc32c.h"
 #include "job_queue.h"
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 #include "memory_budget.h"
 #include "path_policy.h"
 #include "proto_convert.h"

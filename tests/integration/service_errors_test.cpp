@@ -2,7 +2,7 @@
 // outside the data roots, clouds that cannot align, budgets, checksums, authentication.
 #include <gtest/gtest.h>
 
-#include "k4reg/crc32c.h"
+#include "k4reg/util/crc32c.h"
 #include "k4reg/v1/registration.grpc.pb.h"
 #include "test_support.h"
 

@@ -4,8 +4,8 @@
 
 #include <Eigen/Geometry>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/registration.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/registration/registration.h"
 #include "proto_convert.h"
 #include "test_support.h"
 

@@ -8,11 +8,11 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/e57_io.h"
-#include "k4reg/las_io.h"
-#include "k4reg/ptx_io.h"
-#include "k4reg/registration.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/io/e57_io.h"
+#include "k4reg/io/las_io.h"
+#include "k4reg/io/ptx_io.h"
+#include "k4reg/registration/registration.h"
 #include "proto_convert.h"
 #include "../unit/simulated_lab_pair.h"
 #include "test_support.h"

@@ -4,9 +4,9 @@
 
 #include <Eigen/LU>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/metrics.h"
-#include "k4reg/registration.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/registration/metrics.h"
+#include "k4reg/registration/registration.h"
 #include "proto_convert.h"
 #include "sim/scanner.h"
 #include "sim/scene.h"

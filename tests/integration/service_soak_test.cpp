@@ -27,7 +27,7 @@
 #include <sstream>
 #include <thread>
 
-#include "k4reg/crc32c.h"
+#include "k4reg/util/crc32c.h"
 #include "test_support.h"
 
 namespace k4reg::test {

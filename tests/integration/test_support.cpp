@@ -14,10 +14,10 @@
 #include <stdexcept>
 #include <thread>
 
-#include "k4reg/crc32c.h"
+#include "k4reg/util/crc32c.h"
 #include "grpc/health/v1/health.grpc.pb.h"
-#include "k4reg/cloud_io.h"
-#include "k4reg/gt_pairs.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/io/gt_pairs.h"
 #include "sim/scene.h"
 
 extern char** environ;

@@ -17,12 +17,12 @@
 #include <string>
 #include <vector>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/error.h"
-#include "k4reg/gt_pairs.h"
-#include "k4reg/pcd_io.h"
-#include "k4reg/ply_io.h"
-#include "k4reg/xyz_io.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/util/error.h"
+#include "k4reg/io/gt_pairs.h"
+#include "k4reg/io/pcd_io.h"
+#include "k4reg/io/ply_io.h"
+#include "k4reg/io/xyz_io.h"
 
 namespace k4reg {
 namespace {

@@ -1,12 +1,12 @@
 // The 4PCS building blocks: the length-sorted pair index against brute force and its memory bound,
 // congruent sets (the base's own correspondences are among them; dense grids are capped), cancellation.
-#include "k4reg/congruent_sets.h"
+#include "k4reg/registration/congruent_sets.h"
 
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 #include "error_code_of.h"
 
 namespace k4reg {

@@ -3,7 +3,7 @@
 // from the standard's layout independently of the core's writer (bit widths 1–64 with values straddling data
 // packets, index/empty packets, nested prototypes, bad XML, bad packets). Damage: every byte flipped in turn
 // (a CRC-32C mismatch is kDataLoss, never a crash), truncation, huge record counts.
-#include "k4reg/e57_io.h"
+#include "k4reg/io/e57_io.h"
 
 #include <gtest/gtest.h>
 
@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/crc32c.h"
-#include "k4reg/error.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/util/crc32c.h"
+#include "k4reg/util/error.h"
 #include "io_test_support.h"
 
 namespace k4reg {

@@ -5,7 +5,7 @@
 
 #include <functional>
 
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 
 namespace k4reg::test {
 

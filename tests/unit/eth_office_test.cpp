@@ -3,10 +3,10 @@
 // 10 degrees, translation within 1 m of the ground truth), for several seeds.
 #include <gtest/gtest.h>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/four_pcs.h"
-#include "k4reg/gt_pairs.h"
-#include "k4reg/metrics.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/registration/four_pcs.h"
+#include "k4reg/io/gt_pairs.h"
+#include "k4reg/registration/metrics.h"
 
 namespace k4reg {
 namespace {

@@ -7,9 +7,9 @@
 #include <random>
 #include <vector>
 
-#include "k4reg/error.h"
-#include "k4reg/four_pcs.h"
-#include "k4reg/metrics.h"
+#include "k4reg/util/error.h"
+#include "k4reg/registration/four_pcs.h"
+#include "k4reg/registration/metrics.h"
 
 namespace k4reg {
 namespace {

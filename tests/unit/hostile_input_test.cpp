@@ -22,14 +22,14 @@
 
 #include <unistd.h>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/crc32c.h"
-#include "k4reg/e57_io.h"
-#include "k4reg/error.h"
-#include "k4reg/las_io.h"
-#include "k4reg/ptx_io.h"
-#include "k4reg/registration.h"
-#include "k4reg/voxel_grid.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/util/crc32c.h"
+#include "k4reg/io/e57_io.h"
+#include "k4reg/util/error.h"
+#include "k4reg/io/las_io.h"
+#include "k4reg/io/ptx_io.h"
+#include "k4reg/registration/registration.h"
+#include "k4reg/geometry/voxel_grid.h"
 
 // ---- allocation probe ------------------------------------------------------------------------------------
 // The largest single operator-new request while a probe is armed. Process-wide because operator new is; the

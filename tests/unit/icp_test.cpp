@@ -7,9 +7,9 @@
 #include <random>
 #include <vector>
 
-#include "k4reg/icp.h"
-#include "k4reg/metrics.h"
-#include "k4reg/neighbor_grid.h"
+#include "k4reg/registration/icp.h"
+#include "k4reg/registration/metrics.h"
+#include "k4reg/geometry/neighbor_grid.h"
 
 namespace k4reg {
 namespace {

@@ -10,8 +10,8 @@
 #include <functional>
 #include <string>
 
-#include "k4reg/error.h"
-#include "k4reg/point_cloud.h"
+#include "k4reg/util/error.h"
+#include "k4reg/geometry/point_cloud.h"
 
 namespace k4reg::test {
 

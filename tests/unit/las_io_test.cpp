@@ -1,6 +1,6 @@
 // LAS reader and writer: round trips over every point format and version, hand-built headers (independent of
 // the writer), legacy vs 64-bit point counts, extra bytes, intensity normalisation, LAZ refusal, malformed files.
-#include "k4reg/las_io.h"
+#include "k4reg/io/las_io.h"
 
 #include <gtest/gtest.h>
 
@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/error.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/util/error.h"
 #include "io_test_support.h"
 
 namespace k4reg {

@@ -1,4 +1,4 @@
-#include "k4reg/metrics.h"
+#include "k4reg/registration/metrics.h"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>

@@ -7,7 +7,7 @@
 #include <random>
 #include <vector>
 
-#include "k4reg/neighbor_grid.h"
+#include "k4reg/geometry/neighbor_grid.h"
 
 namespace k4reg {
 namespace {

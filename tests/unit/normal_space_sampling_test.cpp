@@ -1,5 +1,5 @@
 // Normal-space sampling: every surface orientation is represented, however few points it has.
-#include "k4reg/normal_space_sampling.h"
+#include "k4reg/geometry/normal_space_sampling.h"
 
 #include <gtest/gtest.h>
 

@@ -1,13 +1,13 @@
 // The evidence a refined pose is judged on: its support and whether it lies on the target surface.
-#include "k4reg/pose_score.h"
+#include "k4reg/registration/pose_score.h"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/gt_pairs.h"
-#include "k4reg/voxel_grid.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/io/gt_pairs.h"
+#include "k4reg/geometry/voxel_grid.h"
 
 namespace k4reg {
 namespace {

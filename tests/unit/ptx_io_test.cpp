@@ -1,6 +1,6 @@
 // PTX reader and writer: hand-written files (matrix convention, zero points, colour columns), multi-scan files
 // with registered poses, scan selection, round trips, malformed and hostile files; PTS with intensity and colour.
-#include "k4reg/ptx_io.h"
+#include "k4reg/io/ptx_io.h"
 
 #include <gtest/gtest.h>
 
@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/error.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/util/error.h"
 #include "io_test_support.h"
 
 namespace k4reg {

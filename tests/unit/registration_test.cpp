@@ -1,6 +1,6 @@
 // End-to-end K-4PCS on real scans with ground truth: the Stanford bunny (no intensity, so the
 // geometric signal), survey-sized coordinates, determinism, cancellation and every error case.
-#include "k4reg/registration.h"
+#include "k4reg/registration/registration.h"
 
 #include <Eigen/LU>
 #include <gtest/gtest.h>
@@ -12,11 +12,11 @@
 #include <random>
 #include <thread>
 
-#include "k4reg/cloud_io.h"
-#include "k4reg/error.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/util/error.h"
 #include "error_code_of.h"
-#include "k4reg/gt_pairs.h"
-#include "k4reg/metrics.h"
+#include "k4reg/io/gt_pairs.h"
+#include "k4reg/registration/metrics.h"
 
 namespace k4reg {
 namespace {

@@ -1,5 +1,5 @@
 // The sampling a scan measures of itself: spacing and robust extent, in the cloud's own units.
-#include "k4reg/sampling.h"
+#include "k4reg/geometry/sampling.h"
 
 #include <gtest/gtest.h>
 

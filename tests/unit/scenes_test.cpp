@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "error_code_of.h"
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 #include "scene_test_support.h"
 #include "sim/bvh.h"
 #include "sim/scanner.h"

@@ -8,8 +8,8 @@
 
 #include <string>
 
-#include "k4reg/metrics.h"
-#include "k4reg/registration.h"
+#include "k4reg/registration/metrics.h"
+#include "k4reg/registration/registration.h"
 #include "sim/scanner.h"
 
 namespace k4reg {

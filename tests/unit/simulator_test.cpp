@@ -13,9 +13,9 @@
 #include <unordered_set>
 #include <vector>
 
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 #include "sim/bvh.h"
-#include "k4reg/matrix_file.h"
+#include "k4reg/io/matrix_file.h"
 #include "sim/scanner.h"
 #include "sim/scene.h"
 #include "sim/scene_builder.h"

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <random>
 
-#include "k4reg/error.h"
-#include "k4reg/surface_signal.h"
+#include "k4reg/util/error.h"
+#include "k4reg/registration/surface_signal.h"
 
 namespace k4reg {
 namespace {

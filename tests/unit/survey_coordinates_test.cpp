@@ -14,10 +14,10 @@
 #include <vector>
 
 #include "io_test_support.h"
-#include "k4reg/cloud_io.h"
-#include "k4reg/e57_io.h"
-#include "k4reg/las_io.h"
-#include "k4reg/registration.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/io/e57_io.h"
+#include "k4reg/io/las_io.h"
+#include "k4reg/registration/registration.h"
 #include "simulated_lab_pair.h"
 
 namespace k4reg {

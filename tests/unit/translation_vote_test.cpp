@@ -1,5 +1,5 @@
 // The translation vote: for a known rotation, the shift where structure meets structure.
-#include "k4reg/translation_vote.h"
+#include "k4reg/registration/translation_vote.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "k4reg/voxel_grid.h"
+#include "k4reg/geometry/voxel_grid.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
@@ -8,7 +8,7 @@
 #include <random>
 #include <tuple>
 
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 
 namespace k4reg {
 namespace {

@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 #include "sim/bvh.h"
 #include "sim/random.h"
 

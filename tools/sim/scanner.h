@@ -15,7 +15,7 @@
 #include <cstdint>
 #include <optional>
 
-#include "k4reg/point_cloud.h"
+#include "k4reg/geometry/point_cloud.h"
 #include "sim/scene.h"
 
 namespace k4reg::sim {

@@ -1,6 +1,6 @@
 #include "sim/scene.h"
 
-#include "k4reg/error.h"
+#include "k4reg/util/error.h"
 #include "sim/scene_builder.h"
 
 namespace k4reg::sim {

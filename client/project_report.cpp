@@ -1,0 +1,111 @@
+#include "project_report.h"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include "k4reg/io/matrix_file.h"
+#include "k4reg/util/error.h"
+#include "result_report.h"
+
+namespace k4reg::cli {
+
+nlohmann::json project_to_json(const ProjectResult& r, const std::vector<std::string>& files, const ProjectParams& params) {
+  nlohmann::json j;
+  j["scans"] = nlohmann::json::array();
+  for (std::size_t i = 0; i < r.scans.size(); ++i) {
+    const ProjectScan& s = r.scans[i];
+    j["scans"].push_back({{"file", files.at(i)},
+                          {"pose", s.registered ? matrix_to_json(s.pose) : nlohmann::json(nullptr)},
+                          {"registered", s.registered},
+                          {"links", s.links},
+                          {"points", s.points}});
+  }
+  j["links"] = nlohmann::json::array();
+  for (const ProjectLink& l : r.links)
+    j["links"].push_back({{"source", l.source},
+                          {"target", l.target},
+                          {"transform", matrix_to_json(l.transform)},
+                          {"rmse_m", l.rmse_m},
+                          {"overlap", l.overlap},
+                          {"cloud_score", l.cloud_score},
+                          {"ambiguity_margin", l.ambiguity_margin},
+                          {"ambiguous", l.ambiguous},
+                          {"accepted", l.accepted},
+                          {"verdict", l.verdict},
+                          {"reason", l.reason},
+                          {"loops", l.loops},
+                          {"loops_closed", l.loops_closed},
+                          {"loop_residual_m", l.loop_residual_m},
+                          {"residual_m", l.residual_m},
+                          {"hypotheses", l.hypotheses},
+                          {"candidate", l.candidate},
+                          {"min_scale_m_used", l.min_scale_m_used},
+                          {"overlap_used", l.overlap_used},
+                          {"seconds", l.seconds}});
+  j["reference"] = r.reference;
+  j["scans_registered"] = r.scans_registered;
+  j["loops_checked"] = r.loops_checked;
+  j["loops_inconsistent"] = r.loops_inconsistent;
+  j["global_rmse_m"] = r.global_rmse_m;
+  j["timings"] = timings_to_json(r.timings);
+  const char* pairs[] = {"all", "sequence", "list"};
+  j["params"] = {{"min_scale_m", params.pairwise.min_scale_m},
+                 {"overlap", params.pairwise.overlap},
+                 {"reference", params.reference},
+                 {"pairs", pairs[static_cast<int>(params.pairs)]},
+                 {"seed", params.pairwise.seed}};
+  return j;
+}
+
+void print_project_table(std::ostream& out, const ProjectResult& r, const std::vector<std::string>& files) {
+  out << fmt::format("{} of {} scans registered (reference: scan {}, {})\n", r.scans_registered, r.scans.size(),
+                     r.reference, files.at(r.reference));
+  for (std::size_t i = 0; i < r.scans.size(); ++i) {
+    const ProjectScan& s = r.scans[i];
+    out << fmt::format("scan {} {}: {}\n", i, files.at(i), s.registered ? "registered" : "NOT registered");
+    if (s.registered) out << format_matrix4(s.pose);
+  }
+  out << fmt::format("{:<6}{:<10}{:>9}{:>9}{:>8}{:>8}{:>12}{:>12}  {}\n", "link", "scans", "rmse m", "overlap", "margin",
+                     "loops", "loop res m", "residual m", "verdict");
+  for (std::size_t k = 0; k < r.links.size(); ++k) {
+    const ProjectLink& l = r.links[k];
+    out << fmt::format("{:<6}{:<10}{:>9.4f}{:>8.0f}%{:>8.3f}{:>8}{:>12.4g}{:>12.4g}  {}{}\n", k,
+                       fmt::format("{}->{}", l.source, l.target), l.rmse_m, 100 * l.overlap, l.ambiguity_margin,
+                       fmt::format("{}/{}", l.loops_closed, l.loops), l.loop_residual_m, l.residual_m,
+                       l.accepted ? "accepted" : "REJECTED", l.reason.empty() ? "" : ": " + l.reason);
+  }
+  out << fmt::format("loops checked {}, inconsistent {}; global rmse {:.4g} m\n", r.loops_checked, r.loops_inconsistent,
+                     r.global_rmse_m);
+  print_timings(out, r.timings);
+}
+
+std::vector<std::string> write_project_dir(const std::string& dir, const ProjectResult& r,
+                                           const std::vector<std::string>& files, const nlohmann::json& json) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) fail(ErrorCode::kPermissionDenied, dir + ": cannot create the output folder: " + ec.message());
+  std::vector<std::string> names;
+  std::set<std::string> taken;
+  for (std::size_t i = 0; i < r.scans.size(); ++i) {
+    if (!r.scans[i].registered) {  // no pose to give: no file that could be mistaken for one
+      names.emplace_back();
+      continue;
+    }
+    const std::string stem = std::filesystem::path(files.at(i)).stem().string();
+    std::string name = stem + ".pose.txt";
+    for (int k = 2; taken.count(name); ++k) name = fmt::format("{}-{}.pose.txt", stem, k);
+    taken.insert(name);
+    write_matrix4((std::filesystem::path(dir) / name).string(), r.scans[i].pose);
+    names.push_back(name);
+  }
+  const std::string path = (std::filesystem::path(dir) / "project.json").string();
+  std::ofstream out(path);
+  out << json.dump(2) << "\n";
+  if (!out) fail(ErrorCode::kPermissionDenied, path + ": cannot write");
+  return names;
+}
+
+}  // namespace k4reg::cli

@@ -1,0 +1,66 @@
+// Loop-consistent selection of pairwise results (after Theiler, Wegner, Schindler 2015): every link (scan
+// pair) brings several distinct candidate transforms, best first; around every triangle of links the chosen
+// candidates must compose to the identity. A link's candidate is chosen to close as many of its triangles
+// as possible (iterated conditional modes: each link in turn takes the candidate that closes most triangles
+// with the others' current choice, until nothing changes; ties keep the pairwise ranking, so the result is
+// deterministic). A closed loop vouches for its links only where the cheapest other labelling that closes
+// it as well is clearly worse: in a symmetric scene a loop with two links turned by the symmetry closes
+// too, so the two smallest pairwise margins of the loop must add up to the margin one pair needs
+// (kAmbiguousMargin). A link whose candidate is not its pairwise winner, or whose winner is poorly
+// supported, counts with margin 0; a link confirmed by other loops counts as certain, so confirmation
+// spreads from the clearest loops outwards. A candidate that closes a vouching loop is confirmed; a link
+// that closes none while one of its loops stays open is contradicted and rejected, with the reason.
+// Cost: O(T * C) per round for T triangles and C candidates per link; T <= N^3 / 6 for N scans, so
+// thousands of triangles for the all-pairs projects this is used on: milliseconds.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace k4reg {
+
+struct LinkCandidates {
+  std::size_t source = 0, target = 0;               // scan indices; transforms map source -> target
+  std::vector<Eigen::Matrix4d> transforms;          // distinct candidates, the pairwise winner first; empty = failed
+  double tolerance_m = 0.0;  // expected error of this link's true candidate (metres of scan displacement)
+  bool ambiguous = false;    // the pairwise verdict on its winner
+  double margin = 1.0;       // the pairwise ambiguity margin of its winner
+  bool well_supported = true;  // its winner lies on the surface and explains what a true pose would
+};
+
+enum class LinkVerdict {
+  kConfirmed,     // its chosen candidate closes at least one loop
+  kUnchecked,     // no loop closes or checks it; accepted on its pairwise verdict (unambiguous)
+  kContradicted,  // closes no vouching loop, and one of its loops stays open: rejected
+  kUnresolved,    // ambiguous pairwise and no loop to decide: rejected
+  kFailed,        // pairwise registration found no candidate
+};
+
+struct LinkSelection {
+  int candidate = -1;         // index into transforms; -1 when rejected or failed
+  LinkVerdict verdict = LinkVerdict::kFailed;
+  int loops = 0;              // triangles through this link whose other two links have a candidate
+  int loops_closed = 0;       // of those, closed with the chosen candidates and vouching for them
+  double loop_residual_m = -1.0;  // smallest residual of its loops with the chosen candidates; -1 = no loop
+  bool accepted() const { return verdict == LinkVerdict::kConfirmed || verdict == LinkVerdict::kUnchecked; }
+};
+
+struct LoopSelectionResult {
+  std::vector<LinkSelection> links;  // one per input link, same order
+  std::size_t loops_checked = 0;       // triangles whose three links have a candidate
+  std::size_t loops_inconsistent = 0;  // of those, not closed with the final choice
+};
+
+// The loop residual tolerance of a triangle: three times the links' expected errors added in quadrature.
+constexpr double kLoopToleranceFactor = 3.0;
+
+// scan_radius_m: per scan, its radius about its frame's origin, which weighs a loop's rotation residual
+// (displacement_m in rigid_motion.h) where the loop starts.
+LoopSelectionResult select_loop_consistent(const std::vector<LinkCandidates>& links,
+                                           const std::vector<double>& scan_radius_m);
+
+const char* to_string(LinkVerdict verdict);
+
+}  // namespace k4reg

@@ -1,0 +1,55 @@
+// Point-to-plane ICP with a Geman-McClure kernel, coarse to fine over voxel grids (e.g. 4, 2, 1 x the
+// finest spacing), each stage iterated until the update is negligible. Deterministic reductions.
+// The target side (downsampled clouds, normals, neighbour grids) is prepared once and can serve many
+// refinements, e.g. one per hypothesis. Cost per iteration: O(source points) neighbour look-ups.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "k4reg/util/cancellation.h"
+#include "k4reg/geometry/neighbor_grid.h"
+#include "k4reg/geometry/point_cloud.h"
+
+namespace k4reg {
+
+struct IcpParams {
+  double voxel_m = 0.05;             // finest stage spacing
+  int stages = 3;                    // spacings voxel_m * 2^(stages-1) ... voxel_m
+  int max_iterations = 50;           // per stage
+  double max_distance_factor = 2.5;  // correspondences within this many stage voxels
+};
+
+struct IcpResult {
+  Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();
+  double rmse_m = 0.0;   // RMS point-to-plane residual of the final inliers
+  double overlap = 0.0;  // share of source points with a target point within the final distance
+  std::size_t inliers = 0;
+  bool converged = false;
+  int iterations = 0;
+};
+
+// One cloud at every stage spacing, coarsest first; the target also gets normals and a grid.
+struct IcpPyramid {
+  struct Stage {
+    double voxel_m = 0.0;
+    std::vector<Eigen::Vector3f> points;
+    std::vector<Eigen::Vector3f> normals;  // target only
+    std::unique_ptr<NeighborGrid> grid;    // target only
+  };
+  std::vector<Stage> stages;
+};
+
+// points: at spacing params.voxel_m (coarser stages are voxelised from them).
+IcpPyramid make_icp_pyramid(const std::vector<Eigen::Vector3f>& points, const IcpParams& params, bool as_target,
+                            const CancellationToken* cancel = nullptr);
+
+IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const Eigen::Matrix4d& initial,
+                     const IcpParams& params, const CancellationToken* cancel = nullptr);
+
+// Normals by local PCA with neighbours within radius_m (grid: over `points`, cells of about radius_m or
+// more); zero where fewer than 3 neighbours.
+std::vector<Eigen::Vector3f> estimate_normals(const std::vector<Eigen::Vector3f>& points, const NeighborGrid& grid,
+                                              double radius_m);
+
+}  // namespace k4reg

@@ -1,0 +1,50 @@
+// The symmetry guard (beyond the paper, whose failures were all 180-degree flips of a symmetric room):
+// each distinct 4PCS hypothesis is settled by a short coarse ICP and re-scored on the voxelised clouds,
+// where the furniture that breaks a room's symmetry is visible: how much of the source the target
+// covers, less how much of it lands in space the target scanner saw to be empty (points the target
+// scanner could not see, or saw from the other side of their surface, are no evidence). 4PCS on a
+// symmetric room often finds only the flipped pose, so the best hypothesis's twins under half turns
+// compete too: about the target's principal axes through its centre, and about the axes of its normals,
+// shifted to where a translation vote on normal-space samples puts them (translation_vote.h).
+// Cost per hypothesis (and per each of nine twins): a few ICP iterations on a few thousand points
+// from two starts and up to two passes over the coarse source; per vote, 1500 x 1500 votes.
+#pragma once
+
+#include <vector>
+
+#include "k4reg/util/cancellation.h"
+#include "k4reg/registration/free_space.h"
+#include "k4reg/registration/icp.h"
+#include "k4reg/geometry/neighbor_grid.h"
+#include "k4reg/geometry/point_cloud.h"
+#include "k4reg/registration/registration.h"
+
+namespace k4reg {
+
+struct SymmetryGuardResult {
+  std::vector<Hypothesis> hypotheses;  // distinct after refinement, best cloud_score first
+  double ambiguity_margin = 1.0;       // (best - runner-up) / best; 1 when there is no runner-up
+};
+
+// What is known of the two scans' viewpoints (terrestrial scans; null for object scans): the target
+// scanner's free space and both scanner positions, each in its own scan's local frame.
+struct ScanViews {
+  const FreeSpaceImage* target_free_space = nullptr;
+  Eigen::Vector3f source_scanner_m = Eigen::Vector3f::Zero();
+  Eigen::Vector3f target_scanner_m = Eigen::Vector3f::Zero();
+};
+
+// The share of the source (points in its local frame) that the target explains under t: points with a
+// reference point within tau, less those the target scanner saw through, of the points it could see
+// (see symmetry_guard.cpp). grid: over reference.points, cells of at least tau.
+double cloud_score(const std::vector<Eigen::Vector3f>& source, const IcpPyramid::Stage& reference,
+                   const NeighborGrid& grid, float tau, const Eigen::Matrix4d& t, const ScanViews* views,
+                   double overlap);
+
+// Uses the two coarsest levels of the ICP pyramids and scores on the second. overlap: the expected share
+// of the source the target sees (the registration's parameter).
+SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& target,
+                                    std::vector<Hypothesis> hypotheses, double overlap, const ScanViews* views,
+                                    const CancellationToken* cancel = nullptr);
+
+}  // namespace k4reg

@@ -1,0 +1,201 @@
+#include "k4reg/project/loop_closure.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <optional>
+#include <utility>
+
+#include "k4reg/geometry/rigid_motion.h"
+#include "k4reg/registration/registration.h"
+
+namespace k4reg {
+namespace {
+
+// A triangle of links a -> b -> c -> a: link indices, and whether each is used against its direction.
+struct Triangle {
+  std::size_t start;  // scan a
+  std::array<std::size_t, 3> link;
+  std::array<bool, 3> inverted;
+};
+
+std::vector<Triangle> find_triangles(const std::vector<LinkCandidates>& links) {
+  std::map<std::pair<std::size_t, std::size_t>, std::size_t> by_pair;  // (low, high) scan -> link
+  std::size_t scans = 0;
+  for (std::size_t i = 0; i < links.size(); ++i) {
+    const auto [s, t] = std::minmax(links[i].source, links[i].target);
+    by_pair.emplace(std::make_pair(s, t), i);
+    scans = std::max(scans, t + 1);
+  }
+  std::vector<std::vector<std::size_t>> neighbours(scans);
+  for (const auto& [pair, link] : by_pair) neighbours[pair.first].push_back(pair.second);  // sorted: map order
+  std::vector<Triangle> triangles;
+  for (std::size_t a = 0; a < scans; ++a)
+    for (std::size_t b : neighbours[a])
+      for (std::size_t c : neighbours[b]) {
+        const auto closing = by_pair.find({a, c});
+        if (closing == by_pair.end()) continue;
+        // Walk a -> b -> c -> a; a link is inverted where it maps the other way.
+        const std::size_t ab = by_pair.at({a, b}), bc = by_pair.at({b, c}), ca = closing->second;
+        triangles.push_back({a, {ab, bc, ca}, {links[ab].source != a, links[bc].source != b, links[ca].source != c}});
+      }
+  return triangles;
+}
+
+}  // namespace
+
+const char* to_string(LinkVerdict verdict) {
+  switch (verdict) {
+    case LinkVerdict::kConfirmed: return "confirmed";
+    case LinkVerdict::kUnchecked: return "unchecked";
+    case LinkVerdict::kContradicted: return "contradicted";
+    case LinkVerdict::kUnresolved: return "unresolved";
+    case LinkVerdict::kFailed: return "failed";
+  }
+  return "?";
+}
+
+LoopSelectionResult select_loop_consistent(const std::vector<LinkCandidates>& links,
+                                           const std::vector<double>& scan_radius_m) {
+  const std::vector<Triangle> triangles = find_triangles(links);
+  std::vector<std::vector<std::size_t>> through(links.size());  // triangles through each link
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (std::size_t l : triangles[t].link) through[l].push_back(t);
+
+  std::vector<int> chosen(links.size(), -1);
+  for (std::size_t l = 0; l < links.size(); ++l)
+    if (!links[l].transforms.empty()) chosen[l] = 0;
+
+  // A triangle's residual and tolerance with the candidates `picks` on its three links.
+  using Picks = std::array<int, 3>;
+  auto loop_residual = [&](const Triangle& tri, const Picks& picks) {
+    Eigen::Matrix4d loop = Eigen::Matrix4d::Identity();
+    double tolerance_sq = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const LinkCandidates& link = links[tri.link[k]];
+      const Eigen::Matrix4d& t = link.transforms[picks[k]];
+      loop = (tri.inverted[k] ? rigid_inverse(t) : t) * loop;
+      tolerance_sq += link.tolerance_m * link.tolerance_m;
+    }
+    return std::make_pair(displacement_m(loop, scan_radius_m.at(tri.start)),
+                          kLoopToleranceFactor * std::sqrt(tolerance_sq));
+  };
+  // Whether the closed loop vouches for its link `self` (see the header); links confirmed by other loops
+  // count as certain.
+  std::vector<bool> trusted(links.size(), false);
+  auto vouches = [&](const Triangle& tri, const Picks& picks, std::size_t self) {
+    std::array<double, 3> margins;
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t m = tri.link[k];
+      margins[k] = m != self && trusted[m] ? 1.0 : picks[k] == 0 && links[m].well_supported ? links[m].margin : 0.0;
+    }
+    std::sort(margins.begin(), margins.end());
+    return margins[0] + margins[1] >= kAmbiguousMargin;
+  };
+  // The current choice on a triangle, with `pick` on link `l`; false when a link of it has no candidate.
+  auto picks_with = [&](const Triangle& tri, std::size_t l, int pick, Picks& picks) {
+    for (int k = 0; k < 3; ++k) picks[k] = tri.link[k] == l ? pick : chosen[tri.link[k]];
+    return std::all_of(picks.begin(), picks.end(), [](int c) { return c >= 0; });
+  };
+  auto closed_count = [&](std::size_t l, int pick) {
+    int closed = 0;
+    Picks picks;
+    for (std::size_t t : through[l]) {
+      if (!picks_with(triangles[t], l, pick, picks)) continue;
+      const auto [r, tol] = loop_residual(triangles[t], picks);
+      closed += r <= tol && vouches(triangles[t], picks, l);
+    }
+    return closed;
+  };
+
+  // The start: per triangle, the closing and vouching choice nearest the pairwise winners (smallest sum of
+  // candidate ranks, among each link's first kJointCandidates); each link takes the candidate most of its
+  // triangles chose this way. Changing one link at a time cannot leave a choice where two links of a
+  // triangle are wrong; this can.
+  constexpr int kJointCandidates = 4;
+  std::vector<std::vector<int>> votes(links.size());
+  for (std::size_t l = 0; l < links.size(); ++l) votes[l].assign(links[l].transforms.size(), 0);
+  for (const Triangle& tri : triangles) {
+    std::optional<Picks> best;
+    Picks p;
+    auto count = [&](std::size_t k) { return std::min<int>(kJointCandidates, links[tri.link[k]].transforms.size()); };
+    for (p[0] = 0; p[0] < count(0); ++p[0])
+      for (p[1] = 0; p[1] < count(1); ++p[1])
+        for (p[2] = 0; p[2] < count(2); ++p[2]) {
+          if (best && p[0] + p[1] + p[2] >= (*best)[0] + (*best)[1] + (*best)[2]) continue;
+          const auto [r, tol] = loop_residual(tri, p);
+          if (r <= tol && vouches(tri, p, links.size())) best = p;
+        }
+    if (best)
+      for (int k = 0; k < 3; ++k) ++votes[tri.link[k]][(*best)[k]];
+  }
+  for (std::size_t l = 0; l < links.size(); ++l)
+    if (!votes[l].empty()) chosen[l] = static_cast<int>(std::max_element(votes[l].begin(), votes[l].end()) - votes[l].begin());
+
+  // Then iterated conditional modes: each link in turn takes the candidate that closes most loops.
+  for (int round = 0; round < 20; ++round) {
+    bool changed = false;
+    for (std::size_t l = 0; l < links.size(); ++l) {
+      if (links[l].transforms.size() < 2) continue;
+      int best = chosen[l], best_closed = closed_count(l, chosen[l]);
+      for (int c = 0; c < static_cast<int>(links[l].transforms.size()); ++c) {
+        const int closed = closed_count(l, c);
+        if (closed > best_closed) best = c, best_closed = closed;
+      }
+      if (best != chosen[l]) chosen[l] = best, changed = true;
+    }
+    if (!changed) break;
+  }
+
+  // The loops of every link with the final choice; links confirmed in one round vouch in the next.
+  LoopSelectionResult out;
+  for (bool growing = true; growing;) {
+    out.links.assign(links.size(), {});
+    for (std::size_t l = 0; l < links.size(); ++l) {
+      LinkSelection& s = out.links[l];
+      Picks picks;
+      for (std::size_t t : through[l]) {
+        if (!picks_with(triangles[t], l, chosen[l], picks)) continue;
+        const auto [r, tol] = loop_residual(triangles[t], picks);
+        ++s.loops;
+        if (r <= tol && vouches(triangles[t], picks, l)) ++s.loops_closed;
+        s.loop_residual_m = s.loop_residual_m < 0 ? r : std::min(s.loop_residual_m, r);
+      }
+    }
+    growing = false;
+    for (std::size_t l = 0; l < links.size(); ++l)
+      if (out.links[l].loops_closed > 0 && !trusted[l]) trusted[l] = growing = true;
+  }
+  // A link that closes no vouching loop while one of its loops stays open is rejected: at least one link
+  // of that loop is wrong and, with no loop to vouch for any, nothing says which (a scan that overlaps
+  // nothing must not ride in on a confident guess). Where its loops close but vouch for nothing, or it is
+  // in none, its pairwise verdict decides.
+  for (std::size_t l = 0; l < links.size(); ++l) {
+    LinkSelection& s = out.links[l];
+    if (chosen[l] < 0) continue;  // kFailed
+    Picks picks;
+    const bool open = std::any_of(through[l].begin(), through[l].end(), [&](std::size_t t) {
+      if (!picks_with(triangles[t], l, chosen[l], picks)) return false;
+      const auto [r, tol] = loop_residual(triangles[t], picks);
+      return r > tol;
+    });
+    if (s.loops_closed > 0)
+      s.verdict = LinkVerdict::kConfirmed;
+    else if (open)
+      s.verdict = LinkVerdict::kContradicted;
+    else
+      s.verdict = links[l].ambiguous ? LinkVerdict::kUnresolved : LinkVerdict::kUnchecked;
+    s.candidate = s.accepted() ? chosen[l] : -1;
+  }
+  for (const Triangle& tri : triangles) {
+    Picks picks;
+    if (!picks_with(tri, links.size(), 0, picks)) continue;
+    const auto [r, tol] = loop_residual(tri, picks);
+    ++out.loops_checked;
+    out.loops_inconsistent += r > tol;
+  }
+  return out;
+}
+
+}  // namespace k4reg

@@ -1,0 +1,273 @@
+#include "k4reg/project/project_registration.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+#include <tuple>
+
+#include "k4reg/geometry/rigid_motion.h"
+#include "k4reg/geometry/sampling.h"
+#include "k4reg/project/loop_closure.h"
+#include "k4reg/project/pose_graph.h"
+#include "k4reg/util/error.h"
+
+namespace k4reg {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+void add_timing(std::vector<StageTiming>& timings, const std::string& stage, double seconds) {
+  auto same = std::find_if(timings.begin(), timings.end(), [&](const StageTiming& t) { return t.stage == stage; });
+  if (same != timings.end())
+    same->seconds += seconds;
+  else
+    timings.push_back({stage, seconds});
+}
+
+// A scan's radius about its frame's origin (the scanner, for terrestrial scans): how far a rotation error
+// moves its points. Robust to stray far returns: half the robust diameter, or the distance to it.
+double scan_radius_m(const PointCloud& cloud) {
+  const double half = 0.5 * robust_diameter(cloud.points);
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3f& p : cloud.points) centre += p.cast<double>();
+  centre = centre / static_cast<double>(cloud.points.size()) + cloud.origin_m;
+  return std::max(half, centre.norm() + half);
+}
+
+// What a true link's transform can be off by: its fine-scale error, or the scale it was found at.
+double link_tolerance_m(const ProjectLink& link) { return std::max(2.0 * link.min_scale_m_used, link.rmse_m); }
+
+// The pose of scan `scan` that a link to an already placed scan proposes.
+Eigen::Matrix4d proposed_pose(const ProjectResult& r, const ProjectLink& link, std::size_t scan) {
+  return scan == link.source ? r.scans[link.target].pose * link.transform
+                             : r.scans[link.source].pose * rigid_inverse(link.transform);
+}
+
+// Initial poses by consensus, one scan at a time from the reference: every accepted link from an unplaced
+// scan to a placed one proposes a pose, and each proposal counts the proposals that agree with it (within
+// the two links' tolerances). A scan is placed only where a strict majority of its links agree; the best
+// supported proposal of all goes first (then more loops closed, better support, lower link index). A wrong
+// link that slipped through the loops is outvoted here rather than carried along a spanning tree. Scans
+// that never gain a majority stay unregistered.
+void place_scans(ProjectResult& r, const std::vector<double>& radius) {
+  for (ProjectScan& scan : r.scans) scan.registered = false, scan.pose = Eigen::Matrix4d::Identity();
+  r.scans[r.reference].registered = true;
+  using Key = std::tuple<std::size_t, int, double, std::size_t>;  // votes, loops closed, score, -link
+  for (;;) {
+    std::optional<std::pair<Key, std::pair<std::size_t, Eigen::Matrix4d>>> best;  // key, (scan, pose)
+    for (std::size_t x = 0; x < r.scans.size(); ++x) {
+      if (r.scans[x].registered) continue;
+      std::vector<std::pair<std::size_t, Eigen::Matrix4d>> proposals;  // link, pose
+      for (std::size_t l : r.scans[x].links) {
+        const ProjectLink& link = r.links[l];
+        if (r.scans[link.source == x ? link.target : link.source].registered)
+          proposals.emplace_back(l, proposed_pose(r, link, x));
+      }
+      for (const auto& [l, pose] : proposals) {
+        std::size_t votes = 0;
+        for (const auto& [m, other] : proposals)
+          votes += displacement_m(rigid_inverse(pose) * other, radius[x]) <=
+                   kLoopToleranceFactor * std::hypot(link_tolerance_m(r.links[l]), link_tolerance_m(r.links[m]));
+        if (2 * votes <= proposals.size()) continue;
+        const Key key{votes, r.links[l].loops_closed, r.links[l].cloud_score, r.links.size() - l};
+        if (!best || key > best->first) best = {key, {x, pose}};
+      }
+    }
+    if (!best) break;
+    r.scans[best->second.first].pose = best->second.second;
+    r.scans[best->second.first].registered = true;
+  }
+}
+
+// Rejects an accepted link: it leaves its scans' lists.
+void reject(ProjectResult& r, std::size_t l, const std::string& reason) {
+  ProjectLink& link = r.links[l];
+  link.accepted = false;
+  link.verdict = "inconsistent";
+  link.reason = reason;
+  for (ProjectScan& scan : r.scans) std::erase(scan.links, l);
+}
+
+}  // namespace
+
+ProjectResult register_project(const std::vector<PointCloud>& scans, const ProjectParams& params,
+                               const CancellationToken* cancel, const ProgressCallback& progress,
+                               const PairCallback& on_pair) {
+  validate(params.pairwise);
+  if (scans.size() < 2)
+    fail(ErrorCode::kInvalidArgument, fmt::format("a project needs at least 2 scans, got {}", scans.size()));
+  if (params.reference >= scans.size())
+    fail(ErrorCode::kInvalidArgument,
+         fmt::format("reference scan {} is out of range: the project has {} scans (indices start at 0)", params.reference,
+                     scans.size()));
+  for (std::size_t i = 0; i < scans.size(); ++i)
+    if (scans[i].empty()) fail(ErrorCode::kInvalidArgument, fmt::format("scan {} is empty", i));
+
+  CancellationToken budget(cancel);
+  if (params.pairwise.time_budget_s > 0)
+    budget.set_deadline(Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(params.pairwise.time_budget_s)));
+  RegistrationParams pairwise = params.pairwise;
+  pairwise.time_budget_s = 0.0;  // the project's deadline covers every pair
+
+  ProjectResult r;
+  r.reference = params.reference;
+  r.scans.resize(scans.size());
+  for (std::size_t i = 0; i < scans.size(); ++i) r.scans[i].points = scans[i].size();
+
+  // 1. Pairwise registration, keeping every distinct hypothesis as a candidate for the loops.
+  const std::vector<ScanPair> pairs = candidate_pairs(scans.size(), params.pairs, params.pair_list);
+  std::vector<LinkCandidates> candidates;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const auto [s, t] = pairs[k];
+    ProjectLink link;
+    link.source = s;
+    link.target = t;
+    LinkCandidates c{s, t, {}, 0.0, false, 0.0, false};
+    const auto start = Clock::now();
+    try {
+      const RegistrationResult pair = register_clouds(scans[s], scans[t], pairwise, &budget, [&](const std::string&, double) {
+        if (progress) progress("pairs", static_cast<double>(k) / pairs.size());
+      });
+      link.rmse_m = pair.rmse_m;
+      link.overlap = pair.overlap;
+      link.cloud_score = pair.hypotheses.front().refined_score > 0 ? pair.hypotheses.front().refined_score
+                                                                    : pair.hypotheses.front().cloud_score;
+      link.ambiguity_margin = pair.ambiguity_margin;
+      link.ambiguous = pair.ambiguous;
+      link.min_scale_m_used = pair.min_scale_m_used;
+      link.overlap_used = pair.overlap_used;
+      c.transforms.push_back(pair.transform);
+      // Runner-ups the free space contradicts outright (a score of 0 or less) cannot be the truth.
+      for (std::size_t h = 1; h < pair.hypotheses.size(); ++h)
+        if (pair.hypotheses[h].cloud_score > 0) c.transforms.push_back(pair.hypotheses[h].transform);
+      link.hypotheses = c.transforms.size();
+      link.transform = pair.transform;
+      c.tolerance_m = link_tolerance_m(link);
+      c.ambiguous = pair.ambiguous;
+      c.margin = pair.ambiguity_margin;
+      c.well_supported = pair.well_supported;
+      for (const StageTiming& t : pair.timings) add_timing(r.timings, t.stage, t.seconds);
+    } catch (const Error& e) {
+      if (e.code() == ErrorCode::kCancelled || e.code() == ErrorCode::kDeadlineExceeded) throw;
+      link.verdict = "failed";
+      link.reason = e.what();
+    }
+    link.seconds = seconds_since(start);
+    if (on_pair) on_pair(link, k, pairs.size());
+    if (progress) progress("pairs", static_cast<double>(k + 1) / pairs.size());
+    r.links.push_back(std::move(link));
+    candidates.push_back(std::move(c));
+  }
+
+  // 2. One candidate per link, so that the loops close.
+  auto start = Clock::now();
+  if (progress) progress("selection", 0.0);
+  std::vector<double> radius(scans.size());
+  for (std::size_t i = 0; i < scans.size(); ++i) radius[i] = scan_radius_m(scans[i]);
+  const LoopSelectionResult selection = select_loop_consistent(candidates, radius);
+  r.loops_checked = selection.loops_checked;
+  r.loops_inconsistent = selection.loops_inconsistent;
+  for (std::size_t l = 0; l < r.links.size(); ++l) {
+    ProjectLink& link = r.links[l];
+    const LinkSelection& s = selection.links[l];
+    link.loops = s.loops;
+    link.loops_closed = s.loops_closed;
+    link.loop_residual_m = s.loop_residual_m;
+    if (candidates[l].transforms.empty()) continue;  // failed, reason set
+    link.verdict = to_string(s.verdict);
+    link.candidate = s.candidate;
+    link.accepted = s.accepted();
+    if (link.accepted) link.transform = candidates[l].transforms[s.candidate];
+    switch (s.verdict) {
+      case LinkVerdict::kConfirmed:
+        link.reason = fmt::format("closes {} of its {} loops{}", s.loops_closed, s.loops,
+                                  s.candidate > 0 ? fmt::format(" with pairwise hypothesis {}, not the winner", s.candidate) : "");
+        break;
+      case LinkVerdict::kUnchecked: link.reason = "no loop checks it; accepted on its pairwise verdict"; break;
+      case LinkVerdict::kContradicted:
+        link.reason = fmt::format("contradicts the loops: none of its {} hypotheses closes any of its {} loops (smallest residual {:.3g} m)",
+                                  candidates[l].transforms.size(), s.loops, s.loop_residual_m);
+        break;
+      case LinkVerdict::kUnresolved:
+        link.reason = "ambiguous pairwise result and no loop to resolve it";
+        break;
+      case LinkVerdict::kFailed: break;
+    }
+    if (link.accepted) {
+      r.scans[link.source].links.push_back(l);
+      r.scans[link.target].links.push_back(l);
+    }
+  }
+  if (progress) progress("selection", 1.0);
+  add_timing(r.timings, "selection", seconds_since(start));
+
+  // 3. Initial poses by consensus, then all poses together over the accepted links that agree with them. A
+  //    link the refined project contradicts by more than its loop tolerance is dropped and all solved again.
+  start = Clock::now();
+  if (progress) progress("refinement", 0.0);
+  for (;;) {
+    check(&budget);
+    place_scans(r, radius);
+    std::vector<std::size_t> used;  // accepted links between registered scans, in agreement with the placement
+    std::vector<PoseGraphLink> graph;
+    std::vector<double> tolerances;
+    for (std::size_t l = 0; l < r.links.size(); ++l) {
+      const ProjectLink& link = r.links[l];
+      if (!link.accepted) continue;
+      if (!r.scans[link.source].registered || !r.scans[link.target].registered) continue;
+      const double misfit = displacement_m(link_misfit(r.scans[link.source].pose, r.scans[link.target].pose, link.transform),
+                                           radius[link.source]);
+      const double tolerance = kLoopToleranceFactor * link_tolerance_m(link);
+      if (misfit > tolerance) {
+        reject(r, l, fmt::format("disagrees with the poses most links support by {:.3g} m (tolerance {:.3g} m)", misfit, tolerance));
+        continue;
+      }
+      used.push_back(l);
+      graph.push_back({link.source, link.target, link.transform, radius[link.source], 1.0});
+      tolerances.push_back(link_tolerance_m(link));
+    }
+    std::vector<Eigen::Matrix4d> poses;
+    for (const ProjectScan& scan : r.scans) poses.push_back(scan.pose);
+    PoseGraphParams solver;
+    solver.fixed = r.reference;
+    if (!tolerances.empty()) {
+      std::vector<double> sorted = tolerances;
+      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+      solver.huber_m = sorted[sorted.size() / 2];
+    }
+    const PoseGraphResult refined = optimize_pose_graph(poses, graph, solver);
+    // The link the refined project contradicts most, beyond its tolerance, goes; then all again.
+    std::size_t worst = used.size();
+    double worst_excess = 1.0;
+    for (std::size_t e = 0; e < used.size(); ++e) {
+      const double excess = refined.residual_m[e] / (kLoopToleranceFactor * tolerances[e]);
+      if (excess > worst_excess) worst = e, worst_excess = excess;
+    }
+    if (worst < used.size()) {
+      reject(r, used[worst], fmt::format("disagrees with the refined project by {:.3g} m (tolerance {:.3g} m)",
+                                         refined.residual_m[worst], kLoopToleranceFactor * tolerances[worst]));
+      continue;
+    }
+    double sum_sq = 0.0;
+    for (std::size_t e = 0; e < used.size(); ++e) {
+      r.links[used[e]].residual_m = refined.residual_m[e];
+      sum_sq += refined.residual_m[e] * refined.residual_m[e];
+    }
+    r.global_rmse_m = used.empty() ? 0.0 : std::sqrt(sum_sq / used.size());
+    for (std::size_t i = 0; i < r.scans.size(); ++i)
+      if (r.scans[i].registered) r.scans[i].pose = refined.poses[i];
+    break;
+  }
+  r.scans_registered = std::count_if(r.scans.begin(), r.scans.end(), [](const ProjectScan& s) { return s.registered; });
+  if (progress) progress("refinement", 1.0);
+  add_timing(r.timings, "refinement", seconds_since(start));
+  return r;
+}
+
+}  // namespace k4reg

@@ -1,0 +1,523 @@
+#include "k4reg/registration/registration.h"
+
+#include <Eigen/Eigenvalues>
+#include <fmt/format.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "k4reg/registration/dog_keypoints.h"
+#include "k4reg/util/error.h"
+#include "k4reg/registration/four_pcs.h"
+#include "k4reg/registration/free_space.h"
+#include "k4reg/registration/icp.h"
+#include "k4reg/geometry/neighbor_grid.h"
+#include "k4reg/registration/pose_score.h"
+#include "k4reg/geometry/rigid_fit.h"
+#include "k4reg/geometry/sampling.h"
+#include "k4reg/registration/surface_signal.h"
+#include "k4reg/registration/symmetry_guard.h"
+#include "k4reg/geometry/voxel_grid.h"
+
+namespace k4reg {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+class StageTimer {
+ public:
+  StageTimer(RegistrationResult& result, const ProgressCallback& progress) : result_(result), progress_(progress) {}
+  template <typename F>
+  auto run(const std::string& stage, F&& f) {
+    if (progress_) progress_(stage, 0.0);
+    const auto start = Clock::now();
+    auto value = f();
+    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    // A stage run twice (the geometric fallback) reports its total.
+    auto same = std::find_if(result_.timings.begin(), result_.timings.end(),
+                             [&](const StageTiming& t) { return t.stage == stage; });
+    if (same != result_.timings.end())
+      same->seconds += seconds;
+    else
+      result_.timings.push_back({stage, seconds});
+    if (progress_) progress_(stage, 1.0);
+    return value;
+  }
+
+ private:
+  RegistrationResult& result_;
+  const ProgressCallback& progress_;
+};
+
+}  // namespace
+
+void validate(const RegistrationParams& p) {
+  auto bad = [](const std::string& what) { fail(ErrorCode::kInvalidArgument, what); };
+  if (!(p.min_scale_m == 0.0 || (p.min_scale_m >= 0.001 && p.min_scale_m <= 10.0)))
+    bad("min_scale_m must be 0 (automatic) or in [0.001, 10] m");
+  if (!(p.overlap == 0.0 || (p.overlap >= 0.05 && p.overlap <= 1.0))) bad("overlap must be 0 (automatic) or in [0.05, 1]");
+  if (p.octaves < 1 || p.octaves > 8) bad("octaves must be in [1, 8]");
+  if (p.scales_per_octave < 1 || p.scales_per_octave > 10) bad("scales_per_octave must be in [1, 10]");
+  if (!(p.min_contrast >= 0.0 && p.min_contrast < 1.0)) bad("min_contrast must be in [0, 1)");
+  if (p.max_bases < 0 || p.max_bases > 1000000) bad("max_bases must be in [0, 1e6]");
+  if (p.hypotheses_kept < 1 || p.hypotheses_kept > 100) bad("hypotheses_kept must be in [1, 100]");
+  if (p.icp_max_iterations < 0 || p.icp_max_iterations > 1000) bad("icp_max_iterations must be in [0, 1000]");
+  if (p.threads < 0 || p.threads > 1024) bad("threads must be in [0, 1024]");
+  // The budget becomes a deadline in 64-bit nanoseconds: 1e9 s (32 years) keeps that conversion in range.
+  if (!(p.time_budget_s >= 0.0 && p.time_budget_s <= 1e9)) bad("time_budget_s must be in [0, 1e9] s");
+  if (!(p.plain_voxel_m >= 0.0 && p.plain_voxel_m <= 100.0)) bad("plain_voxel_m must be in [0, 100] m");
+}
+
+namespace {
+
+// Refuses clouds that cannot define a rigid transform: empty, a single point, a line or a plane.
+void check_geometry(const std::vector<Eigen::Vector3f>& points, double scale_m, const char* name) {
+  if (points.size() < 10)
+    fail(ErrorCode::kInvalidArgument, std::string(name) + " cloud has " + std::to_string(points.size()) +
+                                          " occupied voxels at the minimum scale; at least 10 are needed");
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& p : points) mean += p.cast<double>();
+  mean /= points.size();
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& p : points) cov += (p.cast<double>() - mean) * (p.cast<double>() - mean).transpose();
+  cov /= points.size();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(cov, Eigen::EigenvaluesOnly);
+  const Eigen::Vector3d spread = solver.eigenvalues().cwiseMax(0.0).cwiseSqrt();  // ascending
+  if (spread(1) < scale_m)
+    fail(ErrorCode::kInvalidArgument, std::string(name) + " cloud is degenerate: all points lie on a line");
+  if (spread(0) < 0.5 * scale_m)
+    fail(ErrorCode::kInvalidArgument, std::string(name) + " cloud is degenerate: all points lie on a plane");
+}
+
+// The scanner sits at the file frame's origin, i.e. at -origin_m in the cloud's local frame.
+Eigen::Vector3f scanner_position(const PointCloud& cloud) { return (-cloud.origin_m).cast<float>(); }
+
+// Whether p lies inside the bounding box of the points.
+bool inside_bounds(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& p) {
+  Eigen::Vector3f low = Eigen::Vector3f::Constant(std::numeric_limits<float>::max()), high = -low;
+  for (const Eigen::Vector3f& q : points) {
+    low = low.cwiseMin(q);
+    high = high.cwiseMax(q);
+  }
+  return (p.array() >= low.array()).all() && (p.array() <= high.array()).all();
+}
+
+bool use_free_space(FreeSpaceCheck check, const VoxelizedCloud& source, const VoxelizedCloud& target) {
+  if (check != FreeSpaceCheck::kAuto) return check == FreeSpaceCheck::kOn;
+  // A terrestrial scan in its scanner's frame surrounds the origin at metres. Object scans (whose origin
+  // may sit inside the object) and georeferenced exports (whose origin is a map datum kilometres away)
+  // say nothing about where the scanner stood.
+  constexpr double kMinScannerRange_m = 1.0;
+  auto scanner_known = [&](const PointCloud& cloud) {
+    return inside_bounds(cloud.points, scanner_position(cloud)) &&
+           FreeSpaceImage::median_range_m(cloud.points, scanner_position(cloud)) >= kMinScannerRange_m;
+  };
+  return scanner_known(source.cloud) && scanner_known(target.cloud);
+}
+
+// The voxel spacing at which a cloud keeps about `points` voxels (the paper's plain-4PCS baseline).
+double spacing_for_count(const PointCloud& voxels, double start_m, std::size_t points) {
+  double spacing = start_m;
+  for (int step = 0; step < 40 && voxel_grid(voxels, spacing).cloud.size() > points; ++step) spacing *= 1.25;
+  return spacing;
+}
+
+// The outcome of steps 2-4 for one keypoint signal and one round of bases.
+struct CoarseAlignment {
+  std::string signal;
+  std::size_t source_keypoints = 0, target_keypoints = 0;
+  int bases_tried = 0;
+  double overlap = 0.0;  // whose bases found it
+  SymmetryGuardResult guarded;
+  const Hypothesis& best() const { return guarded.hypotheses.front(); }
+};
+
+// The point sets 4PCS runs on, per keypoint signal (computed once, used by every round of bases).
+struct PointSets {
+  std::string signal;
+  std::vector<Eigen::Vector3f> source, target;
+  std::vector<std::uint8_t> source_labels, target_labels;  // DoG extremum: 1 maximum, 0 minimum
+};
+
+// Source -> target in the files' frames from the transform between the local (origin-shifted) frames.
+Eigen::Matrix4d to_file_frames(const Eigen::Matrix4d& local, const Eigen::Vector3d& source_origin,
+                               const Eigen::Vector3d& target_origin) {
+  Eigen::Matrix4d t = local;
+  t.topRightCorner<3, 1>() += target_origin - local.topLeftCorner<3, 3>() * source_origin;
+  return t;
+}
+
+// Without free space (objects) a true pose explains about the overlap: well supported, and the search
+// for more stops, at min(0.6, 0.75 x overlap). With free space the points the target scanner could not
+// see are no evidence either way, so a true pose explains nearly all the rest (refined scores of the
+// tuning scenes' true poses: 0.88 on sparse 0.4 M-point scans of the monument, else 0.99-1.00) and one
+// that explains less than 0.75 of it is not taken as the truth, however well it beats its rivals (the
+// monument's best wrong poses where 4PCS had missed the truth: 0.6-0.67).
+constexpr double kSignalFallback = 0.6;  // an intensity pose below this meets the geometric signal's best
+constexpr double kWellSupportedWithFreeSpace = 0.75;
+double well_supported(double overlap, bool free_space) {
+  return free_space ? kWellSupportedWithFreeSpace : std::min(kSignalFallback, 0.75 * overlap);
+}
+
+// The automatic overlap: rounds of fresh bases, each for a smaller overlap (more and narrower bases),
+// while no pose is well supported.
+constexpr double kAutoOverlaps[] = {0.8, 0.6, 0.4};
+
+// Hypotheses whose cloud score is within this share of the best are refined fully and judged again.
+constexpr double kContenderBand = 0.2;
+constexpr std::size_t kMaxContenders = 3;
+
+// The single-scale pipeline's outcome: the result, and whether its pose is well supported.
+struct ScaleAttempt {
+  RegistrationResult result;
+  bool supported = false;
+};
+
+// The single-scale pipeline, steps 1-5, at minimum scale sigma.
+ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& target,
+                                     const RegistrationParams& params, double sigma, const CancellationToken* cancel,
+                                     const ProgressCallback& progress) {
+  RegistrationResult result;
+  result.seed = params.seed;
+  result.source_points = source.size();
+  result.target_points = target.size();
+  result.min_scale_m_used = sigma;
+  StageTimer timer(result, progress);
+
+  // 1. Voxel grid at the minimum scale (paper Sec. 2.1).
+  // Named references rather than structured bindings: lambdas below use them, and clang < 16 cannot capture
+  // a structured binding.
+  const auto voxelised = timer.run("voxel_grid", [&] {
+    return std::make_pair(voxel_grid(source, sigma, cancel), voxel_grid(target, sigma, cancel));
+  });
+  const VoxelizedCloud &source_voxels = voxelised.first, &target_voxels = voxelised.second;
+  result.source_voxels = source_voxels.cloud.size();
+  result.target_voxels = target_voxels.cloud.size();
+  check_geometry(source_voxels.cloud.points, sigma, "source");
+  check_geometry(target_voxels.cloud.points, sigma, "target");
+
+  // The ICP pyramids serve the symmetry guard and the final refinement; built once, when first needed.
+  IcpParams icp_params;
+  icp_params.voxel_m = sigma;
+  icp_params.max_iterations = params.icp_max_iterations;
+  std::optional<std::pair<IcpPyramid, IcpPyramid>> pyramids;  // source, target
+  auto icp_pyramids = [&]() -> const std::pair<IcpPyramid, IcpPyramid>& {
+    if (!pyramids)
+      pyramids = timer.run("icp_setup", [&] {
+        return std::make_pair(make_icp_pyramid(source_voxels.cloud.points, icp_params, false, cancel),
+                              make_icp_pyramid(target_voxels.cloud.points, icp_params, true, cancel));
+      });
+    return *pyramids;
+  };
+  // The point precision every 4PCS tolerance derives from. Repeated keypoints of two scans lie within
+  // about 2 sigma of each other (measured on the simulated lab and the bunny); plain 4PCS works on a
+  // coarser grid, whose spacing it is.
+  const bool plain = params.method == CoarseMethod::kPlain4pcs;
+  const double delta = !plain ? 2.0 * sigma : timer.run("plain_grid", [&] {
+    return params.plain_voxel_m > 0 ? params.plain_voxel_m : spacing_for_count(source_voxels.cloud, 4 * sigma, 2000);
+  });
+  result.free_space_used = use_free_space(params.free_space, source_voxels, target_voxels);
+  std::optional<FreeSpaceImage> free_space;
+  if (result.free_space_used)
+    free_space.emplace(target.points, scanner_position(target), 3.0 * delta);  // raw points fill every cell
+  const ScanViews views{free_space ? &*free_space : nullptr, scanner_position(source), scanner_position(target)};
+
+  // 2. The point sets 4PCS runs on: DoG keypoints (K-4PCS) or a coarser voxel grid (plain 4PCS).
+  std::vector<PointSets> point_sets;  // one per signal asked for so far
+  auto sets_for = [&](KeypointSignal signal) -> const PointSets& {
+    const bool intensity = source.has_intensity() && target.has_intensity();
+    for (const PointSets& sets : point_sets)
+      if (sets.signal == (plain ? "voxels" : surface_signal_name(signal, intensity))) return sets;
+    PointSets& sets = point_sets.emplace_back();
+    if (!plain) {
+      timer.run("keypoints", [&] {
+        DogParams dog{sigma, params.octaves, params.scales_per_octave, params.min_contrast};
+        for (const auto* voxels : {&source_voxels, &target_voxels}) {
+          const SurfaceSignal surface = make_surface_signal(voxels->cloud, sigma, signal, intensity, cancel);
+          sets.signal = surface.name;
+          const bool is_source = voxels == &source_voxels;
+          DogKeypoints keypoints = detect_dog_keypoints(voxels->cloud.points, surface.values, dog, cancel);
+          auto& labels = is_source ? sets.source_labels : sets.target_labels;
+          for (const float response : keypoints.response) labels.push_back(response > 0.0f);
+          (is_source ? sets.source : sets.target) = std::move(keypoints.points);
+        }
+        return 0;
+      });
+    } else {
+      timer.run("plain_grid", [&] {
+        sets.source = voxel_grid(source_voxels.cloud, delta, cancel).cloud.points;
+        sets.target = voxel_grid(target_voxels.cloud, delta, cancel).cloud.points;
+        return 0;
+      });
+      sets.signal = "voxels";
+    }
+    return sets;
+  };
+
+  // 2-4. Coarse alignment on one signal with one round of bases: 4PCS, then the symmetry guard.
+  auto coarse = [&](KeypointSignal signal, double overlap, std::uint64_t seed) {
+    const PointSets& sets = sets_for(signal);
+    constexpr std::size_t kMinKeypoints = 8;
+    if (!plain && (sets.source.size() < kMinKeypoints || sets.target.size() < kMinKeypoints))
+      fail(ErrorCode::kFailedPrecondition,
+           "too few keypoints (source " + std::to_string(sets.source.size()) + ", target " +
+               std::to_string(sets.target.size()) + ")");
+    CoarseAlignment out;
+    out.signal = sets.signal;
+    out.source_keypoints = sets.source.size();
+    out.target_keypoints = sets.target.size();
+    out.overlap = overlap;
+
+    // 3. 4PCS on the two point sets (paper Sec. 2.2).
+    const FourPcsResult matched = timer.run("matching", [&] {
+      FourPcsParams four{delta, overlap, params.max_bases, params.hypotheses_kept, seed};
+      if (!plain) four.source_labels = &sets.source_labels, four.target_labels = &sets.target_labels;
+      return match_4pcs(sets.source, sets.target, four, cancel, progress);
+    });
+    out.bases_tried = matched.bases_tried;
+
+    // 4. Symmetry guard: settle each distinct hypothesis with a short coarse ICP and re-score it on the
+    //    voxelised clouds, where the furniture that breaks a room's symmetry is visible.
+    const auto& icp = icp_pyramids();
+    out.guarded = timer.run("symmetry_guard", [&] {
+      return rank_hypotheses(icp.first, icp.second, matched.hypotheses, overlap, free_space ? &views : nullptr, cancel);
+    });
+    return out;
+  };
+
+  // Intensity first, as in the paper. Where its keypoints do not repeat between the scans (dark, noisy
+  // returns at grazing incidence outdoors, or a constant intensity field), the best pose it finds
+  // explains the clouds poorly or none is found at all; then the geometric signal gets its turn, and
+  // the pose the clouds support better stands (the cloud score does not depend on the signal).
+  // With the overlap left automatic, rounds of fresh bases follow while no pose is well supported.
+  const bool may_fall_back =
+      !plain && params.signal == KeypointSignal::kAuto && source.has_intensity() && target.has_intensity();
+  std::vector<double> overlaps{params.overlap};
+  if (params.overlap == 0.0) overlaps.assign(std::begin(kAutoOverlaps), std::end(kAutoOverlaps));
+  std::optional<CoarseAlignment> chosen;
+  std::optional<Error> failure;
+  int bases = 0;
+  std::size_t rounds_run = 0;
+  for (std::size_t round = 0; round < overlaps.size(); ++round) {
+    ++rounds_run;
+    // Round 0 keeps the caller's seed; later rounds draw fresh bases.
+    const std::uint64_t seed = params.seed + 0x9E3779B97F4A7C15ULL * round;
+    auto attempt = [&](KeypointSignal signal) {
+      try {
+        CoarseAlignment candidate = coarse(signal, overlaps[round], seed);
+        bases += candidate.bases_tried;
+        if (!chosen || candidate.best().cloud_score > chosen->best().cloud_score) chosen = std::move(candidate);
+      } catch (const Error& e) {
+        if (e.code() != ErrorCode::kFailedPrecondition) throw;
+        if (!failure) failure = e;
+      }
+    };
+    attempt(params.signal);
+    if (may_fall_back && (!chosen || chosen->best().cloud_score < kSignalFallback)) attempt(KeypointSignal::kGeometric);
+    if (chosen && chosen->best().cloud_score >= well_supported(overlaps[round], result.free_space_used)) break;
+  }
+  if (!chosen) throw *failure;
+  result.signal = chosen->signal;
+  result.source_keypoints = chosen->source_keypoints;
+  result.target_keypoints = chosen->target_keypoints;
+  result.bases_tried = bases;
+  result.overlap_used = chosen->overlap;
+  result.hypotheses = chosen->guarded.hypotheses;
+  result.ambiguity_margin = chosen->guarded.ambiguity_margin;
+
+  // 5. ICP refinement on the voxelised clouds (or just the quality figures with --no-icp). Where
+  //    runner-ups come close, each is refined fully and judged on what symmetry does not copy; every
+  //    refined pose is scored again (pose_score.h).
+  const auto& icp = icp_pyramids();
+  IcpParams final_params = icp_params;
+  if (!params.icp) final_params.max_iterations = 0;  // quality figures only, at the finest stage
+  std::size_t contenders = 1;
+  while (contenders < std::min(kMaxContenders, result.hypotheses.size()) &&
+         result.hypotheses[contenders].cloud_score >= (1.0 - kContenderBand) * result.hypotheses.front().cloud_score)
+    ++contenders;
+  std::vector<IcpResult> refined(contenders);
+  timer.run("icp", [&] {
+    for (std::size_t i = 0; i < contenders; ++i)
+      refined[i] = refine_icp(icp.first, icp.second, result.hypotheses[i].transform, final_params, cancel);
+    return 0;
+  });
+  // Per contender: the share of the source the target explains once refined, and how much of what comes
+  // near the target surface lies on it. Contenders that refined into an earlier one's pose drop out.
+  const PoseScorer scorer(icp.first, icp.second, free_space ? &views : nullptr, result.overlap_used);
+  std::vector<std::size_t> kept;
+  timer.run("verdict", [&] {
+    for (std::size_t i = 0; i < contenders; ++i) {
+      Hypothesis& h = result.hypotheses[i];
+      if (params.icp) h.transform = refined[i].transform;
+      if (std::any_of(kept.begin(), kept.end(), [&](std::size_t k) {
+            return !distinct_transforms(result.hypotheses[k].transform, h.transform, 2.0, 2.0 * sigma);
+          }))
+        continue;
+      h.refined_score = scorer.score(h.transform);
+      if (params.icp) h.surface_agreement = scorer.surface_agreement(h.transform);
+      kept.push_back(i);
+    }
+    return 0;
+  });
+  // A pose off the target surface cannot be the true one, however well supported: contenders on the
+  // surface rank first, then by support (unrefined poses, with --no-icp, are not judged on the surface).
+  auto on_surface = [&](std::size_t i) { return !params.icp || result.hypotheses[i].surface_agreement >= kMinSurfaceAgreement; };
+  std::stable_sort(kept.begin(), kept.end(), [&](std::size_t a, std::size_t b) {
+    if (on_surface(a) != on_surface(b)) return on_surface(a);
+    return result.hypotheses[a].refined_score > result.hypotheses[b].refined_score;
+  });
+  const std::size_t winner = kept[0];
+  const bool on_the_surface = on_surface(winner);
+  // The runner-up is the next contender of the winner's kind; failing one, the best unrefined hypothesis.
+  const auto rival = std::find_if(kept.begin() + 1, kept.end(), [&](std::size_t i) { return on_surface(i) == on_the_surface; });
+  const double winner_score = result.hypotheses[winner].refined_score;
+  if (rival != kept.end())
+    result.ambiguity_margin =
+        winner_score > 0 ? std::clamp((winner_score - result.hypotheses[*rival].refined_score) / winner_score, 0.0, 1.0) : 0.0;
+  else if (contenders > 1)
+    result.ambiguity_margin =
+        contenders < result.hypotheses.size()
+            ? std::clamp(1.0 - result.hypotheses[contenders].cloud_score / result.hypotheses[winner].cloud_score, 0.0, 1.0)
+            : 1.0;
+  // The winner first, the other contenders after it, the rest as they were.
+  std::vector<Hypothesis> reordered;
+  for (std::size_t i : kept) reordered.push_back(result.hypotheses[i]);
+  reordered.insert(reordered.end(), result.hypotheses.begin() + contenders, result.hypotheses.end());
+  result.hypotheses = std::move(reordered);
+  const IcpResult& final_icp = refined[winner];
+  const Hypothesis& best = result.hypotheses.front();
+  const Eigen::Matrix4d local = params.icp ? final_icp.transform : best.transform;
+  result.icp_converged = params.icp && final_icp.converged;
+  result.icp_iterations = params.icp ? final_icp.iterations : 0;
+  result.rmse_m = final_icp.rmse_m;
+  result.overlap = final_icp.overlap;
+  result.inliers = final_icp.inliers;
+
+  // The smallest overlap searched sets what a true pose must explain.
+  const double needed = well_supported(overlaps[std::min(rounds_run, overlaps.size()) - 1], result.free_space_used);
+  if (!on_the_surface) {
+    result.ambiguous = true;
+    result.ambiguity_reason = fmt::format(
+        "off the surface: once refined, {:.0f} % of the source points near the target lie on its surface (true "
+        "poses: {:.0f} % or more)",
+        100 * best.surface_agreement, 100 * kMinSurfaceAgreement);
+  } else if (best.refined_score < needed) {
+    result.ambiguous = true;
+    result.ambiguity_reason = fmt::format(
+        "poorly supported: the best pose explains {:.0f} % of the source once refined (true poses: {:.0f} % or more)",
+        100 * best.refined_score, 100 * needed);
+  } else if (result.hypotheses.size() >= 2 && result.ambiguity_margin < kAmbiguousMargin) {
+    result.ambiguous = true;
+    result.ambiguity_reason = fmt::format(
+        "a runner-up pose is nearly as well supported (margin {:.3f} < {}): the scene may be symmetric; see the hypotheses",
+        result.ambiguity_margin, kAmbiguousMargin);
+  }
+
+  result.transform = to_file_frames(local, source.origin_m, target.origin_m);
+  for (Hypothesis& h : result.hypotheses) h.transform = to_file_frames(h.transform, source.origin_m, target.origin_m);
+  result.well_supported = on_the_surface && best.refined_score >= needed;
+  const bool supported = result.well_supported;
+  return {std::move(result), supported};
+}
+
+// The scales to try, coarsest first: the caller's or the automatic start, halved while a scale finds
+// too few keypoints or no well-supported pose, down to the point spacing.
+class ScaleLadder {
+ public:
+  ScaleLadder(const PointCloud& source, const PointCloud& target, double min_scale_m)
+      : source_(source), target_(target), start_m_(min_scale_m) {
+    if (start_m_ == 0.0) {
+      const Sampling s = measure_sampling(source), t = measure_sampling(target);
+      spacing_m_ = std::max(s.spacing_m, t.spacing_m);
+      const double coarsest = std::min(s.diameter_m, t.diameter_m) / kDiameterPerScale;
+      start_m_ = std::max(std::min(coarsest, kSpacingsPerScale * spacing_m_), 2.0 * spacing_m_);
+      if (!(start_m_ > 0.0))
+        fail(ErrorCode::kInvalidArgument, "the clouds have no extent: all points coincide");
+    }
+  }
+  double start_m() const { return start_m_; }
+  // The scale after `scale_m`, or 0 when none is left.
+  double next(double scale_m, int tried) {
+    if (tried >= kMaxScales) return 0.0;
+    if (spacing_m_ < 0) spacing_m_ = std::max(measure_sampling(source_).spacing_m, measure_sampling(target_).spacing_m);
+    return 0.5 * scale_m >= spacing_m_ ? 0.5 * scale_m : 0.0;
+  }
+
+ private:
+  // The start: DoG scales run from sigma to 2^5 sigma, and at diameter / 128 the coarsest octave still
+  // sees a quarter of the scene, so a scan of any size and unit yields keypoints at every octave. No
+  // coarser than 10 point spacings, though (a voxel then averages ~100 points): a large outdoor scene,
+  // dense near the scanner, would otherwise start at a scale that only its far field needs.
+  static constexpr double kDiameterPerScale = 128.0;
+  static constexpr double kSpacingsPerScale = 10.0;
+  static constexpr int kMaxScales = 4;
+  const PointCloud& source_;
+  const PointCloud& target_;
+  double start_m_;
+  double spacing_m_ = -1.0;  // measured when first needed
+};
+
+// Stage timings of two attempts added up, stage by stage.
+void add_timings(std::vector<StageTiming>& total, const std::vector<StageTiming>& more) {
+  for (const StageTiming& t : more) {
+    auto same = std::find_if(total.begin(), total.end(), [&](const StageTiming& s) { return s.stage == t.stage; });
+    if (same != total.end())
+      same->seconds += t.seconds;
+    else
+      total.push_back(t);
+  }
+}
+
+RegistrationResult run(const PointCloud& source, const PointCloud& target, const RegistrationParams& params,
+                       const CancellationToken* cancel, const ProgressCallback& progress) {
+  ScaleLadder ladder(source, target, params.min_scale_m);
+  std::optional<RegistrationResult> best;
+  std::optional<Error> failure;
+  std::vector<StageTiming> timings;
+  int tried = 0;
+  for (double sigma = ladder.start_m(); sigma > 0.0; sigma = ladder.next(sigma, tried)) {
+    ++tried;
+    try {
+      ScaleAttempt attempt = register_at_scale(source, target, params, sigma, cancel, progress);
+      add_timings(timings, attempt.result.timings);
+      // The first well-supported pose stands; failing one, the best supported of all scales tried.
+      const double support = attempt.result.hypotheses.front().refined_score;
+      if (attempt.supported || !best || support > best->hypotheses.front().refined_score) best = std::move(attempt.result);
+      if (attempt.supported) break;
+    } catch (const Error& e) {
+      if (e.code() != ErrorCode::kFailedPrecondition) throw;
+      if (!failure) failure = e;
+    }
+  }
+  if (!best)
+    fail(ErrorCode::kFailedPrecondition,
+         std::string(failure->what()) + " at every scale tried from " + std::to_string(ladder.start_m()) +
+             " m down to the point spacing: check that the clouds overlap");
+  best->timings = std::move(timings);
+  return std::move(*best);
+}
+
+}  // namespace
+
+RegistrationResult register_clouds(const PointCloud& source, const PointCloud& target, const RegistrationParams& params,
+                                   const CancellationToken* cancel, const ProgressCallback& progress) {
+  validate(params);
+  if (source.empty()) fail(ErrorCode::kInvalidArgument, "source cloud is empty");
+  if (target.empty()) fail(ErrorCode::kInvalidArgument, "target cloud is empty");
+  // A time budget becomes a deadline on a private token that also follows the caller's cancellation.
+  CancellationToken budget(cancel);
+  if (params.time_budget_s > 0)
+    budget.set_deadline(Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(params.time_budget_s)));
+  tbb::task_arena arena(params.threads > 0 ? params.threads : tbb::task_arena::automatic);
+  RegistrationResult result;
+  arena.execute([&] { result = run(source, target, params, &budget, progress); });
+  return result;
+}
+
+}  // namespace k4reg

@@ -1,0 +1,237 @@
+#include "k4reg/registration/symmetry_guard.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "k4reg/registration/four_pcs.h"
+#include "k4reg/registration/icp.h"
+#include "k4reg/geometry/neighbor_grid.h"
+#include "k4reg/geometry/normal_space_sampling.h"
+#include "k4reg/geometry/rigid_fit.h"
+#include "k4reg/registration/translation_vote.h"
+
+namespace k4reg {
+namespace {
+
+// Whether two scanners looked at a surface (normal n, unoriented) from the same side: a pose that
+// matches a surface's front in one scan to its back in the other is wrong (turned upside down, the
+// ground near one scanner fits the ground near the other while everything above it goes underground).
+// Grazing views cannot tell the sides apart.
+bool seen_from_the_same_side(const Eigen::Vector3f& n, const Eigen::Vector3f& view_a, const Eigen::Vector3f& view_b) {
+  constexpr float kGrazingCos = 0.1f;
+  const float a = n.dot(view_a), b = n.dot(view_b);
+  return a * b >= 0.0f || std::abs(a) < kGrazingCos * view_a.norm() || std::abs(b) < kGrazingCos * view_b.norm();
+}
+
+// Centre of the middle 90 % of the points per axis: a room scan's stray points through windows and
+// doors must not pull it, and unlike the centroid it does not follow the scanner's dense near field.
+Eigen::Vector3f trimmed_centre(const std::vector<Eigen::Vector3f>& points) {
+  Eigen::Vector3f centre;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<float> values(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) values[i] = points[i](axis);
+    const std::size_t low = values.size() / 20, high = values.size() - 1 - values.size() / 20;
+    std::nth_element(values.begin(), values.begin() + low, values.end());
+    const float a = values[low];
+    std::nth_element(values.begin(), values.begin() + high, values.end());
+    centre(axis) = 0.5f * (a + values[high]);
+  }
+  return centre;
+}
+
+// The principal axes of the points about their centre, and of the normals (the eigenvectors of
+// sum n n^T): a rectangular room's or a plaza's main surfaces lie along the second set whatever the
+// scan's extent, while the first tilts by degrees where the ground reaches further on one side.
+Eigen::Matrix3d point_axes(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3d& centre) {
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3f& p : points) cov += (p.cast<double>() - centre) * (p.cast<double>() - centre).transpose();
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
+}
+
+Eigen::Matrix3d normal_axes(const std::vector<Eigen::Vector3f>& normals) {
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3f& n : normals) scatter += n.cast<double>() * n.cast<double>().transpose();
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors();
+}
+
+// Half-turns about the columns of `axes` through `centre`: a rectangular room's shell looks the same
+// after a half turn about the vertical (and nearly so about the other two axes), so a pose composed with
+// one of them is where 4PCS's symmetric twin of the true pose lies. As target -> target maps.
+std::vector<Eigen::Matrix4d> half_turns(const Eigen::Matrix3d& axes, const Eigen::Vector3d& centre) {
+  std::vector<Eigen::Matrix4d> turns;
+  for (int axis = 0; axis < 3; ++axis) {
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(M_PI, axes.col(axis).normalized()).toRotationMatrix();
+    Eigen::Matrix4d s = Eigen::Matrix4d::Identity();
+    s.topLeftCorner<3, 3>() = r;
+    s.topRightCorner<3, 1>() = centre - r * centre;
+    turns.push_back(s);
+  }
+  return turns;
+}
+
+// Every k-th point, at most max_points of them.
+std::vector<Eigen::Vector3f> every_kth(const std::vector<Eigen::Vector3f>& points, std::size_t max_points) {
+  const std::size_t step = std::max<std::size_t>(1, (points.size() + max_points - 1) / max_points);
+  std::vector<Eigen::Vector3f> out;
+  for (std::size_t i = 0; i < points.size(); i += step) out.push_back(points[i]);
+  return out;
+}
+
+// Every k-th point of each stage, at most max_points: settling a pose needs thousands of well-spread
+// correspondences, not the tens of thousands of the scored stage (ICP's cost is linear in them).
+IcpPyramid thinned(const IcpPyramid& pyramid, std::size_t max_points) {
+  IcpPyramid thin;
+  thin.stages.resize(pyramid.stages.size());
+  for (std::size_t s = 0; s < pyramid.stages.size(); ++s) {
+    thin.stages[s].voxel_m = pyramid.stages[s].voxel_m;
+    thin.stages[s].points = every_kth(pyramid.stages[s].points, max_points);
+  }
+  return thin;
+}
+
+}  // namespace
+
+// Without views: the share of source points with a target point within tau. With the target's free
+// space, a point is also consistent where it lies at the target scanner's first return in its
+// direction (sparse far surfaces have gaps wider than tau), contradicted where the target scanner saw
+// through it, and no evidence either way where that scanner could not see it (behind its first return,
+// or no return) or where the two scanners saw its surface from opposite sides. Counting unseen points
+// as misses favours the pose that maps one scanner's occlusion shadows onto the other's — in a
+// symmetric room, the flip. So the score is, of the points with evidence, the share consistent less
+// the share contradicted.
+double cloud_score(const std::vector<Eigen::Vector3f>& source, const IcpPyramid::Stage& reference,
+                   const NeighborGrid& grid, float tau, const Eigen::Matrix4d& t, const ScanViews* views,
+                   double overlap) {
+  const Eigen::Affine3f a = to_affine3f(t);
+  const Eigen::Vector3f source_scanner = views ? Eigen::Vector3f(a * views->source_scanner_m) : Eigen::Vector3f::Zero();
+  struct Counts {
+    std::size_t consistent = 0, contradicted = 0, unseen = 0;
+  };
+  // Integer counts: the same for any split over threads.
+  const Counts counts = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, source.size(), 4096), Counts{},
+      [&](const tbb::blocked_range<std::size_t>& range, Counts c) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          const Eigen::Vector3f q = a * source[i];
+          const int k = grid.nearest_within(q, tau);
+          if (k >= 0) {
+            const bool same_side = !views || seen_from_the_same_side(reference.normals[k], q - source_scanner,
+                                                                      reference.points[k] - views->target_scanner_m);
+            ++(same_side ? c.consistent : c.unseen);
+            continue;
+          }
+          if (!views) continue;
+          switch (views->target_free_space->classify(q)) {
+            case FreeSpaceImage::Seen::kSurface: ++c.consistent; break;
+            case FreeSpaceImage::Seen::kEmpty: ++c.contradicted; break;
+            case FreeSpaceImage::Seen::kOccluded:
+            case FreeSpaceImage::Seen::kUnknown: ++c.unseen; break;
+          }
+        }
+        return c;
+      },
+      [](Counts x, const Counts& y) {
+        return Counts{x.consistent + y.consistent, x.contradicted + y.contradicted, x.unseen + y.unseen};
+      });
+  const std::size_t consistent = counts.consistent, contradicted = counts.contradicted, unseen = counts.unseen;
+  // A pose that puts most points out of the target scanner's sight (behind its walls, say) has little
+  // evidence, and the few points left can all agree: the share is taken of at least half the overlap
+  // the caller expects, so such a pose cannot outscore one that the target sees well.
+  const double evidence = std::max(static_cast<double>(source.size() - unseen), 0.5 * overlap * source.size());
+  return (static_cast<double>(consistent) - static_cast<double>(contradicted)) / std::max(1.0, evidence);
+}
+
+SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& target,
+                                    std::vector<Hypothesis> hypotheses, double overlap, const ScanViews* views,
+                                    const CancellationToken* cancel) {
+  constexpr int kStages = 2, kIterations = 6;  // settle, don't polish: the final ICP does that
+  constexpr std::size_t kSettlePoints = 4000;
+  const IcpPyramid settling_source = thinned(source, kSettlePoints);
+  const auto& scored = source.stages.at(kStages - 1);
+  const auto& reference = target.stages.at(kStages - 1);
+  const double voxel_m = reference.voxel_m;
+  const float tau = static_cast<float>(1.5 * voxel_m);
+  const NeighborGrid grid(reference.points, 2.0 * tau);  // 8-cell look-ups for the score
+  IcpParams quick;
+  quick.stages = kStages;
+  quick.max_iterations = kIterations;
+  // A hypothesis can be a metre or two off where it matters, beyond the guard's ICP stages: a 4PCS fit on
+  // keypoints a few metres apart tilts a wide outdoor scene by degrees, and a twin's estimated centre is
+  // rough. Two wider stages (2 and 4 times the pyramid's coarsest spacing, a few thousand points) reach
+  // further, but in a room they can also slide an exact pose along a wall; so each hypothesis settles
+  // from where it is and, if the wide stages take it elsewhere, from there too: the better score stands.
+  IcpParams wide;
+  wide.voxel_m = 2.0 * source.stages.front().voxel_m;
+  wide.stages = 2;
+  wide.max_iterations = 10;
+  const IcpPyramid wide_source = thinned(make_icp_pyramid(source.stages.front().points, wide, false, cancel), kSettlePoints);
+  const IcpPyramid wide_target = make_icp_pyramid(target.stages.front().points, wide, true, cancel);
+  auto settle = [&](Hypothesis& h) {
+    const Eigen::Matrix4d start = h.transform;
+    h.transform = refine_icp(settling_source, target, start, quick, cancel).transform;
+    h.cloud_score = cloud_score(scored.points, reference, grid, tau, h.transform, views, overlap);
+    const Eigen::Matrix4d pulled = refine_icp(wide_source, wide_target, start, wide, cancel).transform;
+    if (!distinct_transforms(pulled, h.transform, 1.0, target.stages.front().voxel_m)) return;  // same basin
+    const Eigen::Matrix4d settled = refine_icp(settling_source, target, pulled, quick, cancel).transform;
+    const double score = cloud_score(scored.points, reference, grid, tau, settled, views, overlap);
+    if (score > h.cloud_score) {
+      h.transform = settled;
+      h.cloud_score = score;
+    }
+  };
+  auto by_score = [](const Hypothesis& a, const Hypothesis& b) { return a.cloud_score > b.cloud_score; };
+  // Hypotheses settle independently (in parallel: a few thousand points each keep one core busy).
+  auto settle_all = [&](std::vector<Hypothesis>& list) {
+    tbb::parallel_for(std::size_t{0}, list.size(), [&](std::size_t i) { settle(list[i]); });
+  };
+  settle_all(hypotheses);
+  std::stable_sort(hypotheses.begin(), hypotheses.end(), by_score);
+  // 4PCS on a symmetric room often finds only the flipped pose; its symmetric twin must compete too.
+  // Turned about the principal axes through the target's centre, or about the normals' axes and then
+  // shifted to where the vote puts it: the symmetric structure need not stand at the centre of its scan.
+  const auto& coarse_source = source.stages.front();
+  const auto& coarse_target = target.stages.front();
+  if (!hypotheses.empty() && coarse_target.points.size() >= 10) {
+    constexpr std::size_t kVoters = 1500, kShifts = 2;
+    const NeighborGrid source_grid(coarse_source.points, 2.5 * coarse_source.voxel_m);
+    const std::vector<Eigen::Vector3f> voting_source = normal_space_sample(
+        coarse_source.points, estimate_normals(coarse_source.points, source_grid, 2.5 * coarse_source.voxel_m), kVoters);
+    const std::vector<Eigen::Vector3f> voting_target =
+        normal_space_sample(coarse_target.points, coarse_target.normals, kVoters);
+    const Eigen::Vector3d centre = trimmed_centre(coarse_target.points).cast<double>();
+    const Eigen::Matrix4d& best = hypotheses.front().transform;
+    std::vector<Hypothesis> twins;
+    for (const Eigen::Matrix4d& s : half_turns(point_axes(coarse_target.points, centre), centre))
+      twins.push_back({s * best, 0.0, 0.0});
+    for (const Eigen::Matrix4d& s : half_turns(normal_axes(coarse_target.normals), centre)) {
+      Eigen::Matrix4d turned = s * best;
+      for (const Eigen::Vector3d& shift : vote_translations(voting_source, voting_target, turned.topLeftCorner<3, 3>(),
+                                                            2.0 * coarse_target.voxel_m, kShifts)) {
+        turned.topRightCorner<3, 1>() = shift;
+        twins.push_back({turned, 0.0, 0.0});
+      }
+    }
+    settle_all(twins);
+    hypotheses.insert(hypotheses.end(), twins.begin(), twins.end());
+    std::stable_sort(hypotheses.begin(), hypotheses.end(), by_score);
+  }
+  SymmetryGuardResult result;
+  // Hypotheses that ICP brought to the same pose are one hypothesis.
+  for (const Hypothesis& h : hypotheses)
+    if (std::all_of(result.hypotheses.begin(), result.hypotheses.end(), [&](const Hypothesis& d) {
+          return distinct_transforms(d.transform, h.transform, 2.0, 2.0 * voxel_m);
+        }))
+      result.hypotheses.push_back(h);
+  const auto& ranked = result.hypotheses;
+  if (ranked.size() >= 2 && ranked[0].cloud_score > 0)
+    result.ambiguity_margin = std::clamp((ranked[0].cloud_score - ranked[1].cloud_score) / ranked[0].cloud_score, 0.0, 1.0);
+  return result;
+}
+
+}  // namespace k4reg

@@ -1,0 +1,150 @@
+// Loop-consistent selection: a wrong pairwise winner is replaced by the candidate that closes the loops,
+// a link with no true candidate is rejected with the loops that contradict it, links no loop checks stand
+// on their pairwise verdict.
+#include <gtest/gtest.h>
+
+#include "k4reg/geometry/rigid_motion.h"
+#include "k4reg/project/loop_closure.h"
+
+namespace k4reg {
+namespace {
+
+Eigen::Matrix4d pose(double yaw, const Eigen::Vector3d& t) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.topLeftCorner<3, 3>() = rotation_exp(Eigen::Vector3d(0, 0, yaw));
+  m.topRightCorner<3, 1>() = t;
+  return m;
+}
+
+// A half turn about the vertical through (5, 0): the symmetric room's flip.
+const Eigen::Matrix4d kFlip = pose(3.14159265, Eigen::Vector3d(10, 0, 0));
+
+struct Project {
+  std::vector<Eigen::Matrix4d> truth{pose(0, {0, 0, 0}), pose(0.7, {2, 1, 0}), pose(1.9, {4, -1, 0.1}), pose(-2.5, {1, 3, 0})};
+  std::vector<double> radius = std::vector<double>(4, 10.0);
+  // source -> target under the truth
+  Eigen::Matrix4d relative(std::size_t s, std::size_t t) const { return rigid_inverse(truth[t]) * truth[s]; }
+  std::vector<LinkCandidates> all_pairs() const {
+    std::vector<LinkCandidates> links;
+    for (std::size_t s = 0; s < 4; ++s)
+      for (std::size_t t = s + 1; t < 4; ++t) links.push_back({s, t, {relative(s, t)}, 0.05, false});
+    return links;
+  }
+};
+
+TEST(LoopClosure, ConsistentProjectConfirmsEveryLink) {
+  const Project p;
+  const LoopSelectionResult r = select_loop_consistent(p.all_pairs(), p.radius);
+  EXPECT_EQ(r.loops_checked, 4u);  // the four triangles of four scans
+  EXPECT_EQ(r.loops_inconsistent, 0u);
+  for (const LinkSelection& s : r.links) {
+    EXPECT_EQ(s.verdict, LinkVerdict::kConfirmed);
+    EXPECT_EQ(s.candidate, 0);
+    EXPECT_EQ(s.loops, 2);
+    EXPECT_EQ(s.loops_closed, 2);
+    EXPECT_LT(s.loop_residual_m, 1e-9);
+  }
+}
+
+TEST(LoopClosure, FlippedWinnerIsReplacedByTheRunnerUpThatClosesTheLoops) {
+  const Project p;
+  std::vector<LinkCandidates> links = p.all_pairs();
+  // Link 1 (scans 0 -> 2): the pairwise winner is the flip, the truth its runner-up; ambiguous or not.
+  links[1].transforms = {kFlip * p.relative(0, 2), p.relative(0, 2)};
+  links[1].ambiguous = false;
+  const LoopSelectionResult r = select_loop_consistent(links, p.radius);
+  EXPECT_EQ(r.links[1].candidate, 1);
+  EXPECT_EQ(r.links[1].verdict, LinkVerdict::kConfirmed);
+  EXPECT_EQ(r.loops_inconsistent, 0u);
+}
+
+TEST(LoopClosure, LinkWithoutATrueCandidateIsContradicted) {
+  const Project p;
+  std::vector<LinkCandidates> links = p.all_pairs();
+  links[2].transforms = {kFlip * p.relative(0, 3), pose(0.3, {1, 0, 0}) * p.relative(0, 3)};
+  const LoopSelectionResult r = select_loop_consistent(links, p.radius);
+  EXPECT_EQ(r.links[2].verdict, LinkVerdict::kContradicted);
+  EXPECT_EQ(r.links[2].candidate, -1);
+  EXPECT_FALSE(r.links[2].accepted());
+  EXPECT_EQ(r.links[2].loops_closed, 0);
+  EXPECT_GT(r.links[2].loop_residual_m, 1.0);
+  EXPECT_EQ(r.loops_inconsistent, 2u);
+  for (std::size_t l : {0, 1, 3, 4, 5}) EXPECT_TRUE(r.links[l].accepted()) << l;
+}
+
+TEST(LoopClosure, ErrorsWithinToleranceCloseTheLoop) {
+  const Project p;
+  std::vector<LinkCandidates> links = p.all_pairs();
+  links[0].transforms[0] = pose(0.001, {0.02, 0, 0}) * links[0].transforms[0];  // 2 cm and 1 mrad x 10 m: ~2.2 cm
+  EXPECT_EQ(select_loop_consistent(links, p.radius).loops_inconsistent, 0u);
+  links[0].transforms[0] = pose(0.0, {0.5, 0, 0}) * p.relative(0, 1);  // far beyond 3 x sqrt(3) x 5 cm
+  const LoopSelectionResult r = select_loop_consistent(links, p.radius);
+  EXPECT_EQ(r.links[0].verdict, LinkVerdict::kContradicted);
+}
+
+TEST(LoopClosure, WithoutLoopsThePairwiseVerdictDecides) {
+  const Project p;
+  std::vector<LinkCandidates> chain{{0, 1, {p.relative(0, 1)}, 0.05, false},
+                                    {1, 2, {p.relative(1, 2)}, 0.05, true},
+                                    {2, 3, {}, 0.05, false}};
+  const LoopSelectionResult r = select_loop_consistent(chain, p.radius);
+  EXPECT_EQ(r.loops_checked, 0u);
+  EXPECT_EQ(r.links[0].verdict, LinkVerdict::kUnchecked);
+  EXPECT_TRUE(r.links[0].accepted());
+  EXPECT_EQ(r.links[1].verdict, LinkVerdict::kUnresolved);
+  EXPECT_FALSE(r.links[1].accepted());
+  EXPECT_EQ(r.links[2].verdict, LinkVerdict::kFailed);
+  EXPECT_EQ(r.links[0].loop_residual_m, -1.0);
+}
+
+TEST(LoopClosure, ScanThatOverlapsNothingLosesAllItsLinks) {
+  // Scan 3's links are confident guesses that disagree with each other; the other three close their loop.
+  const Project p;
+  std::vector<LinkCandidates> links = p.all_pairs();
+  links[2].transforms = {pose(1.0, {7, 7, 0})};   // 0 -> 3
+  links[4].transforms = {pose(-2.0, {-5, 2, 0})};  // 1 -> 3
+  links[5].transforms = {pose(0.4, {3, -9, 1})};   // 2 -> 3
+  const LoopSelectionResult r = select_loop_consistent(links, p.radius);
+  for (std::size_t l : {2, 4, 5}) EXPECT_EQ(r.links[l].verdict, LinkVerdict::kContradicted) << l;
+  for (std::size_t l : {0, 1, 3}) EXPECT_EQ(r.links[l].verdict, LinkVerdict::kConfirmed) << l;
+}
+
+// In a symmetric room every pair is ambiguous, and two links turned by the symmetry close a loop as well
+// as the truth: a loop confirms only where the two smallest margins add up to what one pair needs.
+TEST(LoopClosure, AmbiguousLinksConfirmEachOtherOnlyWithEnoughMarginBetweenThem) {
+  const Project p;
+  for (const auto& [margin, confirmed] : {std::pair{0.03, true}, std::pair{0.02, false}}) {
+    std::vector<LinkCandidates> links = p.all_pairs();
+    for (LinkCandidates& l : links) l.ambiguous = true, l.margin = margin;
+    const LoopSelectionResult r = select_loop_consistent(links, p.radius);
+    for (const LinkSelection& s : r.links) {
+      EXPECT_EQ(s.verdict, confirmed ? LinkVerdict::kConfirmed : LinkVerdict::kUnresolved) << margin;
+      EXPECT_EQ(s.loops_closed, confirmed ? 2 : 0) << margin;
+    }
+    EXPECT_EQ(r.loops_inconsistent, 0u);
+  }
+}
+
+TEST(LoopClosure, PoorlySupportedWinnersVouchForNothing) {
+  // Scan 3 is placed the same wrong way by both of its doubtful links (a symmetric object seen from one
+  // side): their loop closes, yet proves nothing.
+  const Project p;
+  std::vector<LinkCandidates> links = p.all_pairs();
+  // Each of scan 3's links puts it flipped about scan 0's frame: consistent among themselves.
+  for (std::size_t l : {2, 4, 5}) {
+    const std::size_t s = links[l].source;
+    links[l].transforms = {rigid_inverse(kFlip * p.truth[3]) * p.truth[s]};
+    links[l].ambiguous = true;
+    links[l].well_supported = false;
+    links[l].margin = 0.2;
+  }
+  const LoopSelectionResult r = select_loop_consistent(links, p.radius);
+  for (std::size_t l : {2, 4, 5}) {
+    EXPECT_FALSE(r.links[l].accepted()) << l;
+    EXPECT_EQ(r.links[l].loops_closed, 0) << l;
+  }
+  for (std::size_t l : {0, 1, 3}) EXPECT_EQ(r.links[l].verdict, LinkVerdict::kConfirmed) << l;
+}
+
+}  // namespace
+}  // namespace k4reg

@@ -1,0 +1,183 @@
+// Project registration end to end on real range scans (the Stanford bunny, each scan moved by its own
+// random rigid motion), and the ways a project can be malformed.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <random>
+
+#include "k4reg/geometry/rigid_motion.h"
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/io/gt_pairs.h"
+#include "k4reg/project/project_registration.h"
+#include "k4reg/util/error.h"
+
+namespace k4reg {
+namespace {
+
+const std::string kBunny = std::string(K4REG_TEST_DATA_DIR) + "/bunny/";
+
+// A random rigid motion: any rotation, a shift of up to 0.5 m.
+Eigen::Matrix4d random_motion(std::mt19937& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.topLeftCorner<3, 3>() = rotation_exp(Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized() * 3.0 * std::abs(u(rng)) * 2);
+  m.topRightCorner<3, 1>() = Eigen::Vector3d(u(rng), u(rng), u(rng));
+  return m;
+}
+
+PointCloud moved(const PointCloud& cloud, const Eigen::Matrix4d& m) {
+  std::vector<Eigen::Vector3d> points;
+  for (const Eigen::Vector3f& p : cloud.points)
+    points.push_back(m.topLeftCorner<3, 3>() * (p.cast<double>() + cloud.origin_m) + m.topRightCorner<3, 1>());
+  return make_local_cloud(points, cloud.intensity);
+}
+
+// RMS over the scan's points of the distance between where the pose and the truth put them.
+double rms_error_m(const PointCloud& scan, const Eigen::Matrix4d& pose, const Eigen::Matrix4d& truth) {
+  double sum = 0.0;
+  for (const Eigen::Vector3f& p : scan.points) {
+    Eigen::Vector4d q = Eigen::Vector4d::Ones();
+    q.head<3>() = p.cast<double>() + scan.origin_m;
+    sum += (pose * q - truth * q).squaredNorm();
+  }
+  return std::sqrt(sum / scan.size());
+}
+
+// Six bunny scans with a ground-truth transform into bun000's frame, each moved at random.
+struct BunnyProject {
+  std::vector<std::string> files{"bun000.ply", "bun045.ply", "bun090.ply", "bun270.ply", "bun315.ply", "chin.ply"};
+  std::vector<PointCloud> scans;
+  std::vector<Eigen::Matrix4d> truth;  // p_project (the moved bun000's frame) = truth * p_scan
+  BunnyProject() {
+    std::map<std::string, Eigen::Matrix4d> to_bun000{{"bun000.ply", Eigen::Matrix4d::Identity()}};
+    for (const GtPair& p : read_gt_pairs(kBunny + "gt_pairs.log"))
+      if (p.target == "bun000.ply") to_bun000[p.source] = p.T_target_source;
+    std::mt19937 rng(11);
+    std::vector<Eigen::Matrix4d> motion;
+    for (const std::string& f : files) {
+      motion.push_back(random_motion(rng));
+      scans.push_back(moved(read_cloud(kBunny + f), motion.back()));
+    }
+    for (std::size_t i = 0; i < files.size(); ++i)
+      truth.push_back(motion[0] * to_bun000.at(files[i]) * rigid_inverse(motion[i]));
+  }
+};
+
+ProjectParams statue_params() {
+  ProjectParams p;
+  p.pairwise.min_scale_m = 0.002;
+  p.pairwise.overlap = 0.5;
+  p.pairwise.seed = 1;
+  return p;
+}
+
+TEST(ProjectRegistration, BunnyScansAllRegisteredWithinAMillimetre) {
+  const BunnyProject bunny;
+  std::size_t pairs_reported = 0;
+  const ProjectResult r = register_project(bunny.scans, statue_params(), nullptr, {},
+                                           [&](const ProjectLink&, std::size_t, std::size_t total) {
+                                             ++pairs_reported;
+                                             EXPECT_EQ(total, 15u);
+                                           });
+  EXPECT_EQ(pairs_reported, 15u);
+  ASSERT_EQ(r.scans.size(), 6u);
+  EXPECT_EQ(r.scans_registered, 6u);
+  EXPECT_TRUE(r.scans[0].pose.isApprox(Eigen::Matrix4d::Identity()));
+  for (std::size_t i = 0; i < 6; ++i) {
+    EXPECT_TRUE(r.scans[i].registered) << bunny.files[i];
+    EXPECT_LT(rms_error_m(bunny.scans[i], r.scans[i].pose, bunny.truth[i]), 0.001) << bunny.files[i];
+  }
+  EXPECT_EQ(r.links.size(), 15u);
+  EXPECT_EQ(r.loops_checked, 20u);
+  EXPECT_GT(r.global_rmse_m, 0.0);
+  EXPECT_LT(r.global_rmse_m, 0.002);
+  for (const ProjectLink& l : r.links) {
+    if (l.accepted) {
+      EXPECT_GE(l.residual_m, 0.0);
+    }
+  }
+  // Pairwise stages, then the project's own.
+  auto stage = [&](const std::string& name) {
+    return std::any_of(r.timings.begin(), r.timings.end(), [&](const StageTiming& t) { return t.stage == name; });
+  };
+  EXPECT_TRUE(stage("keypoints") && stage("selection") && stage("refinement"));
+}
+
+TEST(ProjectRegistration, ScanOfAnotherObjectIsNotRegisteredAndTheRestStill) {
+  BunnyProject bunny;
+  // A mirrored bunny: shaped like the others, but no rigid motion puts it on them.
+  std::vector<Eigen::Vector3d> mirrored;
+  for (const Eigen::Vector3f& p : bunny.scans[1].points) mirrored.push_back(Eigen::Vector3d(-p.x(), p.y(), p.z()) + bunny.scans[1].origin_m);
+  std::vector<PointCloud> scans{bunny.scans[0], bunny.scans[1], bunny.scans[4], make_local_cloud(mirrored, {})};
+  const ProjectResult r = register_project(scans, statue_params());
+  EXPECT_FALSE(r.scans[3].registered);
+  for (std::size_t i : {0, 1, 2}) {
+    EXPECT_TRUE(r.scans[i].registered) << i;
+    const std::size_t original = i == 2 ? 4 : i;
+    EXPECT_LT(rms_error_m(scans[i], r.scans[i].pose, bunny.truth[original]), 0.001) << i;
+  }
+  for (const ProjectLink& l : r.links)
+    if (l.source == 3 || l.target == 3) {
+      EXPECT_FALSE(l.accepted);
+      EXPECT_FALSE(l.reason.empty());
+    }
+}
+
+TEST(ProjectRegistration, SameResultAtAnyThreadCount) {
+  const BunnyProject bunny;
+  std::vector<PointCloud> scans(bunny.scans.begin(), bunny.scans.begin() + 3);
+  ProjectParams one = statue_params(), two = statue_params();
+  one.pairwise.threads = 1;
+  two.pairwise.threads = 2;
+  const ProjectResult a = register_project(scans, one), b = register_project(scans, two);
+  for (std::size_t i = 0; i < scans.size(); ++i) EXPECT_EQ(a.scans[i].pose, b.scans[i].pose) << i;
+}
+
+TEST(ProjectRegistration, ReferenceScanKeepsTheIdentity) {
+  const BunnyProject bunny;
+  std::vector<PointCloud> scans(bunny.scans.begin(), bunny.scans.begin() + 3);
+  ProjectParams params = statue_params();
+  params.reference = 1;
+  const ProjectResult r = register_project(scans, params);
+  EXPECT_EQ(r.reference, 1u);
+  EXPECT_TRUE(r.scans[1].pose.isApprox(Eigen::Matrix4d::Identity()));
+  // Against the truth re-expressed in scan 1's frame.
+  const Eigen::Matrix4d to_scan1 = rigid_inverse(bunny.truth[1]);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_LT(rms_error_m(scans[i], r.scans[i].pose, to_scan1 * bunny.truth[i]), 0.001) << i;
+}
+
+TEST(ProjectRegistration, MalformedProjectsAreRefusedWithAReason) {
+  const BunnyProject bunny;
+  auto code_of = [](auto&& f) {
+    try {
+      f();
+    } catch (const Error& e) {
+      return e.code();
+    }
+    return ErrorCode::kInternal;
+  };
+  EXPECT_EQ(code_of([&] { register_project({}, statue_params()); }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(code_of([&] { register_project({bunny.scans[0]}, statue_params()); }), ErrorCode::kInvalidArgument);
+  ProjectParams bad_reference = statue_params();
+  bad_reference.reference = 2;
+  EXPECT_EQ(code_of([&] { register_project({bunny.scans[0], bunny.scans[1]}, bad_reference); }), ErrorCode::kInvalidArgument);
+  ProjectParams bad_list = statue_params();
+  bad_list.pairs = PairSelection::kList;
+  bad_list.pair_list = {{0, 5}};
+  EXPECT_EQ(code_of([&] { register_project({bunny.scans[0], bunny.scans[1]}, bad_list); }), ErrorCode::kInvalidArgument);
+  CancellationToken cancelled;
+  cancelled.cancel();
+  EXPECT_EQ(code_of([&] { register_project({bunny.scans[0], bunny.scans[1]}, statue_params(), &cancelled); }),
+            ErrorCode::kCancelled);
+}
+
+TEST(CandidatePairs, AllSequenceAndList) {
+  EXPECT_EQ(candidate_pairs(4, PairSelection::kAll).size(), 6u);
+  EXPECT_EQ(candidate_pairs(4, PairSelection::kSequence), (std::vector<ScanPair>{{0, 1}, {0, 2}, {1, 2}, {1, 3}, {2, 3}}));
+  EXPECT_EQ(candidate_pairs(4, PairSelection::kList, {{3, 1}, {1, 3}, {0, 2}}), (std::vector<ScanPair>{{0, 2}, {1, 3}}));
+  EXPECT_THROW(candidate_pairs(4, PairSelection::kList, {{2, 2}}), Error);
+}
+
+}  // namespace
+}  // namespace k4reg
