@@ -30,6 +30,7 @@
 #include "k4reg/io/gt_pairs.h"
 #include "k4reg/registration/registration.h"
 #include "markdown_block.h"
+#include "random_motion.h"
 #include "simulated_scan_cache.h"
 #include "statistics.h"
 #include "truth_error.h"
@@ -62,29 +63,6 @@ struct Run {
   double rmse_m = kNan, seconds = 0.0, min_scale_used = 0.0, overlap_used = 0.0, margin = 0.0;
   std::string note;
 };
-
-// A random rigid motion: uniform rotation, translation up to `reach` per axis.
-Eigen::Matrix4d random_motion(std::uint64_t seed, double reach) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> normal;
-  Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
-  q.normalize();
-  std::uniform_real_distribution<double> shift(-reach, reach);
-  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  m.topLeftCorner<3, 3>() = q.toRotationMatrix();
-  m.topRightCorner<3, 1>() = Eigen::Vector3d(shift(rng), shift(rng), shift(rng));
-  return m;
-}
-
-PointCloud moved(const PointCloud& cloud, const Eigen::Matrix4d& m) {
-  std::vector<Eigen::Vector3d> world;
-  world.reserve(cloud.size());
-  for (const auto& p : cloud.points) {
-    const Eigen::Vector3d q = cloud.origin_m + p.cast<double>();
-    world.push_back(m.topLeftCorner<3, 3>() * q + m.topRightCorner<3, 1>());
-  }
-  return make_local_cloud(world, cloud.intensity, "moved cloud");
-}
 
 // Pairs of a real data set (gt_pairs.log), chosen by index; each source moved by its own random motion.
 Suite real_suite(std::string name, std::string part, std::string what, const fs::path& folder,

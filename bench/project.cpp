@@ -1,0 +1,248 @@
+// k4reg-bench-project: project registration (register_project, as `k4reg align-project` runs it) on
+// simulated and real projects, split into a tuning part and a held-out part like k4reg-bench-blind.
+//
+//   k4reg-bench-project [--part tuning|held-out|all] [--suites NAME,...] [--seeds N] [--data-dir DIR]
+//                       [--cache-dir DIR] [--results-dir DIR] [--markdown FILE] [--list]
+//
+// Every scan's pose is scored against the ground truth relative to the reference scan (RMS over the
+// scan's points of the distance between where the pose and the truth put them) and counted as correct,
+// not registered (a refusal), or a confident miss (registered but off: the outcome to avoid).
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/io/gt_pairs.h"
+#include "k4reg/project/project_registration.h"
+#include "k4reg/util/error.h"
+#include "markdown_block.h"
+#include "random_motion.h"
+#include "simulated_scan_cache.h"
+#include "statistics.h"
+#include "truth_error.h"
+
+namespace fs = std::filesystem;
+
+namespace k4reg::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Project {
+  std::vector<PointCloud> scans;
+  std::vector<Eigen::Matrix4d> truth;  // scan -> a common frame
+};
+
+struct Suite {
+  std::string name, part, what;
+  double min_scale_m = 0.0, overlap = 0.0;  // 0 = automatic
+  double success_rmse_m = 0.05;
+  std::function<Project(std::uint64_t seed)> load;
+};
+
+struct Run {
+  std::string suite, part;
+  std::uint64_t seed = 0;
+  std::size_t scans = 0, correct = 0, unregistered = 0, confident_misses = 0, links = 0, accepted = 0;
+  std::size_t loops = 0, inconsistent = 0;
+  double worst_rmse_m = 0.0, seconds = 0.0;
+  bool refused = false;
+  std::string note;
+};
+
+Suite simulated(const std::string& scene, int layout, std::vector<int> stations, std::size_t points, double threshold,
+                double min_scale_m, double overlap, std::string part, const std::string& cache) {
+  Suite s{fmt::format("{}-L{}-{}st", scene, layout, stations.size()), std::move(part),
+          fmt::format("{} layout {}, stations {}, {} k points, sigma {}, overlap {}", scene, layout,
+                      fmt::join(stations, " "), points / 1000, min_scale_m > 0 ? fmt::format("{} m", min_scale_m) : "auto",
+                      overlap > 0 ? fmt::format("{}", overlap) : "auto"),
+          min_scale_m, overlap, threshold, {}};
+  s.load = [=](std::uint64_t) {
+    Project p;
+    for (int st : stations) {
+      const CachedScan c = cached_simulated_scan(cache, scene, st, points, layout);
+      p.scans.push_back(read_cloud(c.path));
+      p.truth.push_back(c.scan_to_scene);
+    }
+    return p;
+  };
+  return s;
+}
+
+// Scans of a real data set whose gt_pairs.log links them all to `files[0]`, each moved at random.
+Suite real(std::string name, std::string what, const fs::path& folder, std::vector<std::string> files, double threshold,
+           double min_scale_m, double overlap, std::string part) {
+  Suite s{std::move(name), std::move(part), std::move(what), min_scale_m, overlap, threshold, {}};
+  s.load = [=](std::uint64_t seed) {
+    // Poses into files[0]'s frame, chained through the log's pairs.
+    std::map<std::string, Eigen::Matrix4d> to_first{{files[0], Eigen::Matrix4d::Identity()}};
+    const std::vector<GtPair> pairs = read_gt_pairs((folder / "gt_pairs.log").string());
+    for (bool grew = true; grew;) {
+      grew = false;
+      for (const GtPair& g : pairs) {
+        if (to_first.count(g.target) && !to_first.count(g.source))
+          to_first[g.source] = to_first[g.target] * g.T_target_source, grew = true;
+        else if (to_first.count(g.source) && !to_first.count(g.target))
+          to_first[g.target] = to_first[g.source] * g.T_target_source.inverse(), grew = true;
+      }
+    }
+    Project p;
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      const Eigen::Matrix4d motion = random_motion(seed * 1000 + i, 0.2);
+      p.scans.push_back(moved(read_cloud((folder / files[i]).string()), motion));
+      p.truth.push_back(to_first.at(files[i]) * motion.inverse());
+    }
+    return p;
+  };
+  return s;
+}
+
+std::vector<Suite> all_suites(const fs::path& data, const std::string& cache) {
+  const fs::path bunny = data / "stanford-bunny-scans";
+  // Tuning: what the selection was developed on (the bunny's ten scans, hall layout 0, monument layout 3).
+  // Held out: other layouts of those scenes, the simulated statuette, the courtyard.
+  return {
+      real("bunny-10", "Stanford bunny, all 10 scans, sigma 2 mm, overlap 0.5", bunny,
+           {"bun000.ply", "bun045.ply", "bun090.ply", "bun180.ply", "bun270.ply", "bun315.ply", "chin.ply", "ear_back.ply",
+            "top2.ply", "top3.ply"},
+           0.001, 0.002, 0.5, "tuning"),
+      simulated("hall", 0, {0, 1, 2, 4}, 700000, 0.05, 0.1, 0.4, "tuning", cache),
+      simulated("monument", 3, {0, 1, 2}, 700000, 0.1, 0.1, 0.4, "tuning", cache),
+      simulated("hall", 1, {0, 1, 2, 4}, 700000, 0.05, 0.1, 0.4, "held-out", cache),
+      simulated("hall", 2, {0, 1, 3, 4}, 700000, 0.05, 0.1, 0.4, "held-out", cache),
+      simulated("monument", 0, {0, 1, 2}, 700000, 0.1, 0.1, 0.4, "held-out", cache),
+      simulated("monument", 1, {0, 1, 3}, 700000, 0.1, 0.1, 0.4, "held-out", cache),
+      simulated("monument", 2, {0, 1, 2}, 700000, 0.1, 0.1, 0.4, "held-out", cache),
+      simulated("object", 1, {0, 1, 2, 3, 4, 5, 6, 7, 8, 9}, 40000, 0.001, 0.002, 0.5, "held-out", cache),
+      simulated("courtyard", 0, {0, 1, 2, 3}, 700000, 0.1, 0.1, 0.4, "held-out", cache),
+  };
+}
+
+Run run_one(const Suite& suite, std::uint64_t seed) {
+  Run run;
+  run.suite = suite.name, run.part = suite.part, run.seed = seed;
+  const Project project = suite.load(seed);
+  run.scans = project.scans.size();
+  ProjectParams params;
+  params.pairwise.min_scale_m = suite.min_scale_m;
+  params.pairwise.overlap = suite.overlap;
+  params.pairwise.seed = seed;
+  const auto start = Clock::now();
+  try {
+    const ProjectResult r = register_project(project.scans, params);
+    run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    const Eigen::Matrix4d to_reference = project.truth[r.reference].inverse();
+    for (std::size_t i = 0; i < r.scans.size(); ++i) {
+      if (!r.scans[i].registered) {
+        ++run.unregistered;
+        run.note += fmt::format(" {}:unregistered", i);
+        continue;
+      }
+      const double rmse = file_frame_error(project.scans[i], r.scans[i].pose, to_reference * project.truth[i]).rmse_m;
+      run.worst_rmse_m = std::max(run.worst_rmse_m, rmse);
+      if (rmse < suite.success_rmse_m) {
+        ++run.correct;
+      } else {
+        ++run.confident_misses;
+        run.note += fmt::format(" {}:off {:.3g} m", i, rmse);
+      }
+    }
+    run.links = r.links.size();
+    for (const ProjectLink& l : r.links) run.accepted += l.accepted;
+    run.loops = r.loops_checked;
+    run.inconsistent = r.loops_inconsistent;
+  } catch (const Error& e) {
+    run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    run.refused = true;
+    run.note = e.what();
+  }
+  return run;
+}
+
+std::string report(const std::vector<Suite>& suites, const std::vector<Run>& runs) {
+  std::ostringstream out;
+  out << "| part | project | what | runs | scans | correct | not registered | **confident miss** | worst error | "
+         "links accepted | median time |\n|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const std::string part : {"tuning", "held-out"})
+    for (const Suite& s : suites) {
+      if (s.part != part) continue;
+      std::size_t n = 0, scans = 0, correct = 0, unregistered = 0, confident = 0, links = 0, accepted = 0;
+      double worst = 0.0;
+      std::vector<double> times;
+      for (const Run& r : runs) {
+        if (r.suite != s.name) continue;
+        ++n, scans += r.scans, correct += r.correct, confident += r.confident_misses, links += r.links, accepted += r.accepted;
+        unregistered += r.refused ? r.scans : r.unregistered;
+        worst = std::max(worst, r.worst_rmse_m);
+        times.push_back(r.seconds);
+      }
+      if (n == 0) continue;
+      out << fmt::format("| {} | {} | {} | {} | {} | {} ({:.0f} %) | {} | **{}** | {:.3g} m (limit {:g}) | {} / {} | {:.1f} s |\n",
+                         part, s.name, s.what, n, scans, correct, 100.0 * correct / scans, unregistered, confident, worst,
+                         s.success_rmse_m, accepted, links, median(times));
+    }
+  return out.str();
+}
+
+}  // namespace
+}  // namespace k4reg::bench
+
+int main(int argc, char** argv) {
+  using namespace k4reg::bench;
+  CLI::App app{"Registers the tuning and held-out projects and reports both, scan by scan against the truth."};
+  std::string part = "all", names, data_dir = "../shared/data", cache_dir = "build-bench/bench-cache",
+              results_dir = "bench/results", markdown = "bench/RESULTS.md";
+  int seeds = 1;
+  bool list = false;
+  app.add_option("--part", part, "tuning, held-out or all")->check(CLI::IsMember({"tuning", "held-out", "all"}));
+  app.add_option("--suites", names, "comma-separated project names (default: every project of the part)");
+  app.add_option("--seeds", seeds, "seeds per project")->check(CLI::Range(1, 100));
+  app.add_option("--data-dir", data_dir, "the real data sets (shared/data)");
+  app.add_option("--cache-dir", cache_dir, "simulated scans are cached here");
+  app.add_option("--results-dir", results_dir, "runs CSV goes here");
+  app.add_option("--markdown", markdown, "RESULTS.md to update (block \"project\"); empty = none");
+  app.add_flag("--list", list, "list the projects and exit");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    const auto suites = all_suites(data_dir, cache_dir);
+    std::vector<Run> runs;
+    fs::create_directories(results_dir);
+    std::ofstream csv(fs::path(results_dir) / "project-runs.csv");
+    csv << "part,project,seed,scans,correct,unregistered,confident_misses,refused,worst_rmse_m,links,accepted,loops,"
+           "loops_inconsistent,seconds,note\n";
+    for (const Suite& s : suites) {
+      if (list) {
+        std::printf("%-22s %-9s %s\n", s.name.c_str(), s.part.c_str(), s.what.c_str());
+        continue;
+      }
+      if ((part != "all" && s.part != part) || (!names.empty() && ("," + names + ",").find("," + s.name + ",") == std::string::npos))
+        continue;
+      for (int seed = 1; seed <= seeds; ++seed) {
+        const Run r = run_one(s, seed);
+        runs.push_back(r);
+        std::printf("%-9s %-22s seed %d: %zu/%zu correct, %zu unregistered, %zu CONFIDENT MISSES, worst %.3g m, links %zu/%zu, "
+                    "loops %zu (%zu open), %.1f s%s\n",
+                    r.part.c_str(), r.suite.c_str(), seed, r.correct, r.scans, r.unregistered, r.confident_misses,
+                    r.worst_rmse_m, r.accepted, r.links, r.loops, r.inconsistent, r.seconds, r.note.c_str());
+        std::fflush(stdout);
+        csv << r.part << ',' << r.suite << ',' << seed << ',' << r.scans << ',' << r.correct << ',' << r.unregistered << ','
+            << r.confident_misses << ',' << r.refused << ',' << r.worst_rmse_m << ',' << r.links << ',' << r.accepted << ','
+            << r.loops << ',' << r.inconsistent << ',' << r.seconds << ",\"" << r.note << "\"\n";
+      }
+    }
+    if (list) return 0;
+    const std::string table = report(suites, runs);
+    std::printf("\n%s", table.c_str());
+    if (!markdown.empty()) replace_block(markdown, "project", table);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "k4reg-bench-project: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

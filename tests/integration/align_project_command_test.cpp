@@ -1,0 +1,83 @@
+// `k4reg align-project` as a user runs it: the JSON layout, the --out-dir files, and the ways a project can
+// be malformed (each one line on stderr and exit code 1).
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "test_support.h"
+
+namespace k4reg::test {
+namespace {
+
+CommandRun k4reg(std::vector<std::string> args) {
+  args.insert(args.begin(), K4REG_BIN_DIR "/k4reg");
+  return run_command(std::move(args));
+}
+
+std::string bunny(const std::string& name) { return (bunny_dir() / name).string(); }
+
+const std::vector<std::string> kFlags{"--min-scale", "0.002", "--overlap", "0.5", "--seed", "1"};
+
+std::vector<std::string> with_flags(std::vector<std::string> args) {
+  args.insert(args.end(), kFlags.begin(), kFlags.end());
+  return args;
+}
+
+TEST(AlignProjectCommand, JsonHasEveryScanAsGivenAndTheOutDirItsPoses) {
+  TempDir dir;
+  const CommandRun run = k4reg(with_flags({"align-project", bunny("bun000.ply"), bunny("bun045.ply"), bunny("bun315.ply"),
+                                           "--json", "--out-dir", (dir.path() / "out").string()}));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  ASSERT_EQ(j["scans"].size(), 3u);
+  EXPECT_EQ(j["scans"][1]["file"], bunny("bun045.ply"));
+  for (const auto& scan : j["scans"]) {
+    EXPECT_TRUE(scan["registered"].get<bool>());
+    EXPECT_EQ(scan["pose"].size(), 16u);
+  }
+  EXPECT_EQ(j["scans"][0]["pose"][0], 1.0);  // the reference
+  ASSERT_EQ(j["links"].size(), 3u);
+  for (const char* key : {"source", "target", "transform", "rmse_m", "overlap", "cloud_score", "ambiguity_margin", "accepted",
+                          "verdict", "reason", "loops", "loops_closed", "loop_residual_m", "residual_m"})
+    EXPECT_TRUE(j["links"][0].contains(key)) << key;
+  EXPECT_EQ(j["loops_checked"], 1);
+  for (const char* file : {"bun000.pose.txt", "bun045.pose.txt", "bun315.pose.txt", "project.json"})
+    EXPECT_TRUE(fs::exists(dir.path() / "out" / file)) << file;
+  std::ifstream saved(dir.path() / "out" / "project.json");
+  EXPECT_EQ(nlohmann::json::parse(saved)["scans"], j["scans"]);
+}
+
+TEST(AlignProjectCommand, SequencePairsAndTableOutput) {
+  const CommandRun run = k4reg(
+      with_flags({"align-project", bunny("bun000.ply"), bunny("bun045.ply"), bunny("bun315.ply"), "--pairs", "sequence"}));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("3 of 3 scans registered"), std::string::npos) << run.out;
+}
+
+TEST(AlignProjectCommand, MalformedProjectsAreOneLineAndExitOne) {
+  TempDir dir;
+  const std::string garbage = (dir.path() / "garbage.ply").string();
+  std::ofstream(garbage) << "ply\nthis is not a header\n";
+  const std::string pairs = (dir.path() / "pairs.txt").string();
+  std::ofstream(pairs) << "0 1\n0 7\n";
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases{
+      {{"align-project", bunny("bun000.ply"), bunny("bun000.ply")}, "given twice"},
+      {{"align-project", bunny("bun000.ply")}, "at least 2 scans"},
+      {{"align-project", bunny("bun000.ply"), garbage}, "garbage.ply"},
+      {{"align-project", bunny("bun000.ply"), bunny("bun045.ply"), "--pairs", pairs}, "names a scan beyond"},
+      {{"align-project", bunny("bun000.ply"), bunny("bun045.ply"), "--reference", "2"}, "reference scan 2 is out of range"},
+  };
+  for (const Case& c : cases) {
+    const CommandRun run = k4reg(with_flags(c.args));
+    EXPECT_EQ(run.exit_code, 1) << c.message;
+    EXPECT_NE(run.err.find(c.message), std::string::npos) << run.err;
+    EXPECT_TRUE(run.out.empty()) << run.out;
+  }
+}
+
+}  // namespace
+}  // namespace k4reg::test
