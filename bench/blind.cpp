@@ -32,6 +32,7 @@
 #include "markdown_block.h"
 #include "random_motion.h"
 #include "simulated_scan_cache.h"
+#include "split_options.h"
 #include "statistics.h"
 #include "truth_error.h"
 
@@ -229,34 +230,24 @@ std::string report(const std::vector<Suite>& suites, const std::vector<Run>& run
 int main(int argc, char** argv) {
   using namespace k4reg::bench;
   CLI::App app{"Registers the blind protocol's tuning and held-out pairs and reports both."};
-  std::string part = "all", names, data_dir = "../shared/data", cache_dir = "build-bench/bench-cache",
-              results_dir = "bench/results", markdown = "bench/RESULTS.md";
-  int seeds = 3;
-  bool list = false;
-  app.add_option("--part", part, "tuning, held-out or all")->check(CLI::IsMember({"tuning", "held-out", "all"}));
-  app.add_option("--suites", names, "comma-separated suite names (default: every suite of the part)");
-  app.add_option("--seeds", seeds, "seeds per pair")->check(CLI::Range(1, 100));
-  app.add_option("--data-dir", data_dir, "the real data sets (shared/data)");
-  app.add_option("--cache-dir", cache_dir, "simulated scans are cached here");
-  app.add_option("--results-dir", results_dir, "runs CSV goes here");
-  app.add_option("--markdown", markdown, "RESULTS.md to update (block \"blind\"); empty = none");
-  app.add_flag("--list", list, "list the suites and exit");
+  SplitOptions o;
+  o.seeds = 3;
+  o.add_to(app, "blind");
   CLI11_PARSE(app, argc, argv);
   try {
-    const auto suites = all_suites(data_dir, cache_dir);
+    const auto suites = all_suites(o.data_dir, o.cache_dir);
     std::vector<Run> runs;
-    fs::create_directories(results_dir);
-    std::ofstream csv(fs::path(results_dir) / "blind-runs.csv");
+    fs::create_directories(o.results_dir);
+    std::ofstream csv(fs::path(o.results_dir) / "blind-runs.csv");
     csv << "part,suite,pair,seed,success,ambiguous,refused,rmse_m,seconds,min_scale_m_used,overlap_used,margin,note\n";
     for (const Suite& s : suites) {
-      if (list) {
+      if (o.list) {
         std::printf("%-22s %-9s %zu pairs  %s\n", s.name.c_str(), s.part.c_str(), s.pairs.size(), s.what.c_str());
         continue;
       }
-      if ((part != "all" && s.part != part) || (!names.empty() && ("," + names + ",").find("," + s.name + ",") == std::string::npos))
-        continue;
+      if (!o.selected(s.part, s.name)) continue;
       for (std::size_t k = 0; k < s.pairs.size(); ++k)
-        for (int seed = 1; seed <= seeds; ++seed) {
+        for (int seed = 1; seed <= o.seeds; ++seed) {
           const Run r = run_one(s, k, seed);
           runs.push_back(r);
           std::printf("%-9s %-20s %-28s seed %d: %s rmse %.4g (%.2f s, sigma %.3g, overlap %.2f, margin %.3f) %s\n",
@@ -269,10 +260,10 @@ int main(int argc, char** argv) {
               << r.margin << ",\"" << r.note << "\"\n";
         }
     }
-    if (list) return 0;
+    if (o.list) return 0;
     const std::string table = report(suites, runs);
     std::printf("\n%s", table.c_str());
-    if (!markdown.empty()) replace_block(markdown, "blind", table);
+    if (!o.markdown.empty()) replace_block(o.markdown, "blind", table);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "k4reg-bench-blind: %s\n", e.what());
     return 1;

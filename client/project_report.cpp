@@ -21,7 +21,9 @@ nlohmann::json project_to_json(const ProjectResult& r, const std::vector<std::st
                           {"pose", s.registered ? matrix_to_json(s.pose) : nlohmann::json(nullptr)},
                           {"registered", s.registered},
                           {"links", s.links},
-                          {"points", s.points}});
+                          {"points", s.points},
+                          {"strength", s.strength},
+                          {"reason", s.reason}});
   }
   j["links"] = nlohmann::json::array();
   for (const ProjectLink& l : r.links)
@@ -33,6 +35,7 @@ nlohmann::json project_to_json(const ProjectResult& r, const std::vector<std::st
                           {"cloud_score", l.cloud_score},
                           {"ambiguity_margin", l.ambiguity_margin},
                           {"ambiguous", l.ambiguous},
+                          {"well_supported", l.well_supported},
                           {"accepted", l.accepted},
                           {"verdict", l.verdict},
                           {"reason", l.reason},
@@ -65,7 +68,8 @@ void print_project_table(std::ostream& out, const ProjectResult& r, const std::v
                      r.reference, files.at(r.reference));
   for (std::size_t i = 0; i < r.scans.size(); ++i) {
     const ProjectScan& s = r.scans[i];
-    out << fmt::format("scan {} {}: {}\n", i, files.at(i), s.registered ? "registered" : "NOT registered");
+    out << fmt::format("scan {} {}: {}\n", i, files.at(i),
+                       s.registered ? fmt::format("registered (strength {:.3f})", s.strength) : "NOT registered: " + s.reason);
     if (s.registered) out << format_matrix4(s.pose);
   }
   out << fmt::format("{:<6}{:<10}{:>9}{:>9}{:>8}{:>8}{:>12}{:>12}  {}\n", "link", "scans", "rmse m", "overlap", "margin",

@@ -85,7 +85,7 @@ TEST(ProjectRegistration, BunnyScansAllRegisteredWithinAMillimetre) {
   EXPECT_EQ(r.scans_registered, 6u);
   EXPECT_TRUE(r.scans[0].pose.isApprox(Eigen::Matrix4d::Identity()));
   for (std::size_t i = 0; i < 6; ++i) {
-    EXPECT_TRUE(r.scans[i].registered) << bunny.files[i];
+    EXPECT_TRUE(r.scans[i].registered) << bunny.files[i] << ": " << r.scans[i].reason;
     EXPECT_LT(rms_error_m(bunny.scans[i], r.scans[i].pose, bunny.truth[i]), 0.001) << bunny.files[i];
   }
   EXPECT_EQ(r.links.size(), 15u);

@@ -48,6 +48,7 @@ std::vector<Triangle> find_triangles(const std::vector<LinkCandidates>& links) {
 const char* to_string(LinkVerdict verdict) {
   switch (verdict) {
     case LinkVerdict::kConfirmed: return "confirmed";
+    case LinkVerdict::kConsistent: return "consistent";
     case LinkVerdict::kUnchecked: return "unchecked";
     case LinkVerdict::kContradicted: return "contradicted";
     case LinkVerdict::kUnresolved: return "unresolved";
@@ -167,23 +168,36 @@ LoopSelectionResult select_loop_consistent(const std::vector<LinkCandidates>& li
     for (std::size_t l = 0; l < links.size(); ++l)
       if (out.links[l].loops_closed > 0 && !trusted[l]) trusted[l] = growing = true;
   }
-  // A link that closes no vouching loop while one of its loops stays open is rejected: at least one link
-  // of that loop is wrong and, with no loop to vouch for any, nothing says which (a scan that overlaps
-  // nothing must not ride in on a confident guess). Where its loops close but vouch for nothing, or it is
-  // in none, its pairwise verdict decides.
+  // An open loop has at least one wrong link. It blames an unconfirmed link of it unless a doubtful link
+  // (ambiguous pairwise, confirmed by no loop) explains it: one whose partner is confirmed or doubtful too.
+  // Where a doubtful link's partner is only unambiguous, nothing says which of the three is wrong, so the
+  // loop blames both others as well (a scan that overlaps nothing must not ride in on a confident guess).
+  // A link blamed by no open loop is consistent where all its loops close, else stands on its pairwise
+  // verdict.
+  auto confirmed = [&](std::size_t m) { return out.links[m].loops_closed > 0; };
+  auto doubtful = [&](std::size_t m) { return !confirmed(m) && (chosen[m] < 0 || links[m].ambiguous); };
   for (std::size_t l = 0; l < links.size(); ++l) {
     LinkSelection& s = out.links[l];
     if (chosen[l] < 0) continue;  // kFailed
     Picks picks;
-    const bool open = std::any_of(through[l].begin(), through[l].end(), [&](std::size_t t) {
-      if (!picks_with(triangles[t], l, chosen[l], picks)) return false;
+    bool open = false, blamed = false;
+    for (std::size_t t : through[l]) {
+      if (!picks_with(triangles[t], l, chosen[l], picks)) continue;
       const auto [r, tol] = loop_residual(triangles[t], picks);
-      return r > tol;
-    });
+      if (r <= tol) continue;
+      open = true;
+      std::array<std::size_t, 2> other;
+      std::copy_if(triangles[t].link.begin(), triangles[t].link.end(), other.begin(), [&](std::size_t m) { return m != l; });
+      const auto [a, b] = other;
+      const bool explained = (doubtful(a) && (doubtful(b) || confirmed(b))) || (doubtful(b) && (doubtful(a) || confirmed(a)));
+      blamed = blamed || !explained;
+    }
     if (s.loops_closed > 0)
       s.verdict = LinkVerdict::kConfirmed;
-    else if (open)
+    else if (blamed)
       s.verdict = LinkVerdict::kContradicted;
+    else if (s.loops > 0 && !open)
+      s.verdict = LinkVerdict::kConsistent;
     else
       s.verdict = links[l].ambiguous ? LinkVerdict::kUnresolved : LinkVerdict::kUnchecked;
     s.candidate = s.accepted() ? chosen[l] : -1;

@@ -12,6 +12,7 @@
 #include "k4reg/geometry/sampling.h"
 #include "k4reg/project/loop_closure.h"
 #include "k4reg/project/pose_graph.h"
+#include "k4reg/project/scan_strength.h"
 #include "k4reg/util/error.h"
 
 namespace k4reg {
@@ -55,7 +56,7 @@ Eigen::Matrix4d proposed_pose(const ProjectResult& r, const ProjectLink& link, s
 // link that slipped through the loops is outvoted here rather than carried along a spanning tree. Scans
 // that never gain a majority stay unregistered.
 void place_scans(ProjectResult& r, const std::vector<double>& radius) {
-  for (ProjectScan& scan : r.scans) scan.registered = false, scan.pose = Eigen::Matrix4d::Identity();
+  for (ProjectScan& scan : r.scans) scan.registered = false, scan.pose = Eigen::Matrix4d::Identity(), scan.reason.clear();
   r.scans[r.reference].registered = true;
   using Key = std::tuple<std::size_t, int, double, std::size_t>;  // votes, loops closed, score, -link
   for (;;) {
@@ -82,6 +83,17 @@ void place_scans(ProjectResult& r, const std::vector<double>& radius) {
     r.scans[best->second.first].pose = best->second.second;
     r.scans[best->second.first].registered = true;
   }
+  for (ProjectScan& scan : r.scans)
+    if (!scan.registered)
+      scan.reason = scan.links.empty() ? "no accepted link connects it to the others (see its links' reasons)"
+                                       : "its accepted links do not agree on where it goes, or reach the reference";
+}
+
+// A link's weight in the scans' strength: its pairwise margin where its winner was chosen and is well
+// supported, at least one pair's worth where a vouching loop confirmed it, else nothing.
+double strength_weight(const ProjectLink& link) {
+  const double margin = link.candidate == 0 && link.well_supported ? link.ambiguity_margin : 0.0;
+  return link.verdict == "confirmed" ? std::max(margin, kAmbiguousMargin) : margin;
 }
 
 // Rejects an accepted link: it leaves its scans' lists.
@@ -140,6 +152,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
                                                                     : pair.hypotheses.front().cloud_score;
       link.ambiguity_margin = pair.ambiguity_margin;
       link.ambiguous = pair.ambiguous;
+      link.well_supported = pair.well_supported;
       link.min_scale_m_used = pair.min_scale_m_used;
       link.overlap_used = pair.overlap_used;
       c.transforms.push_back(pair.transform);
@@ -189,13 +202,16 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
         link.reason = fmt::format("closes {} of its {} loops{}", s.loops_closed, s.loops,
                                   s.candidate > 0 ? fmt::format(" with pairwise hypothesis {}, not the winner", s.candidate) : "");
         break;
-      case LinkVerdict::kUnchecked: link.reason = "no loop checks it; accepted on its pairwise verdict"; break;
+      case LinkVerdict::kConsistent:
+        link.reason = fmt::format("closes its {} loops, though none alone tells it from a symmetric twin", s.loops);
+        break;
+      case LinkVerdict::kUnchecked: link.reason = "in no loop; accepted on its pairwise verdict"; break;
       case LinkVerdict::kContradicted:
         link.reason = fmt::format("contradicts the loops: none of its {} hypotheses closes any of its {} loops (smallest residual {:.3g} m)",
                                   candidates[l].transforms.size(), s.loops, s.loop_residual_m);
         break;
       case LinkVerdict::kUnresolved:
-        link.reason = "ambiguous pairwise result and no loop to resolve it";
+        link.reason = "ambiguous pairwise result in no loop that could resolve it";
         break;
       case LinkVerdict::kFailed: break;
     }
@@ -231,6 +247,26 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
       used.push_back(l);
       graph.push_back({link.source, link.target, link.transform, radius[link.source], 1.0});
       tolerances.push_back(link_tolerance_m(link));
+    }
+    // Scans held too weakly to tell from a symmetric twin leave the project, with their links.
+    std::vector<WeightedLink> weighted;
+    for (std::size_t l : used) weighted.push_back({r.links[l].source, r.links[l].target, strength_weight(r.links[l])});
+    const std::vector<double> strength = scan_strengths(r.scans.size(), weighted, r.reference, 1.0);
+    for (std::size_t i = 0; i < r.scans.size(); ++i) {
+      r.scans[i].strength = r.scans[i].registered ? strength[i] : 0.0;
+      if (r.scans[i].registered && strength[i] < kAmbiguousMargin) {
+        r.scans[i].registered = false;
+        r.scans[i].reason = fmt::format(
+            "held too weakly: its links' pairwise margins (strength {:.3f} < {}) cannot tell it from a symmetric twin",
+            strength[i], kAmbiguousMargin);
+      }
+    }
+    for (std::size_t e = used.size(); e-- > 0;) {
+      const ProjectLink& link = r.links[used[e]];
+      if (r.scans[link.source].registered && r.scans[link.target].registered) continue;
+      used.erase(used.begin() + e);
+      graph.erase(graph.begin() + e);
+      tolerances.erase(tolerances.begin() + e);
     }
     std::vector<Eigen::Matrix4d> poses;
     for (const ProjectScan& scan : r.scans) poses.push_back(scan.pose);

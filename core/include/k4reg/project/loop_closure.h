@@ -8,8 +8,10 @@
 // too, so the two smallest pairwise margins of the loop must add up to the margin one pair needs
 // (kAmbiguousMargin). A link whose candidate is not its pairwise winner, or whose winner is poorly
 // supported, counts with margin 0; a link confirmed by other loops counts as certain, so confirmation
-// spreads from the clearest loops outwards. A candidate that closes a vouching loop is confirmed; a link
-// that closes none while one of its loops stays open is contradicted and rejected, with the reason.
+// spreads from the clearest loops outwards. A candidate that closes a vouching loop is confirmed. A link
+// that closes none is contradicted (rejected, with the reason) by an open loop that no doubtful link
+// explains (see select_loop_consistent); one whose loops all close without vouching is consistent
+// (accepted: the scans' strength decides).
 // Cost: O(T * C) per round for T triangles and C candidates per link; T <= N^3 / 6 for N scans, so
 // thousands of triangles for the all-pairs projects this is used on: milliseconds.
 #pragma once
@@ -32,9 +34,11 @@ struct LinkCandidates {
 
 enum class LinkVerdict {
   kConfirmed,     // its chosen candidate closes at least one loop
-  kUnchecked,     // no loop closes or checks it; accepted on its pairwise verdict (unambiguous)
-  kContradicted,  // closes no vouching loop, and one of its loops stays open: rejected
-  kUnresolved,    // ambiguous pairwise and no loop to decide: rejected
+  kConsistent,    // closes all its loops, though none vouches for it (a symmetric scene): accepted, and
+                  // how firmly it holds its scans is left to scan_strength.h
+  kUnchecked,     // in no loop; accepted on its pairwise verdict (unambiguous)
+  kContradicted,  // closes no vouching loop, and an open loop blames it: rejected
+  kUnresolved,    // ambiguous pairwise and in no loop: rejected
   kFailed,        // pairwise registration found no candidate
 };
 
@@ -44,7 +48,9 @@ struct LinkSelection {
   int loops = 0;              // triangles through this link whose other two links have a candidate
   int loops_closed = 0;       // of those, closed with the chosen candidates and vouching for them
   double loop_residual_m = -1.0;  // smallest residual of its loops with the chosen candidates; -1 = no loop
-  bool accepted() const { return verdict == LinkVerdict::kConfirmed || verdict == LinkVerdict::kUnchecked; }
+  bool accepted() const {
+    return verdict == LinkVerdict::kConfirmed || verdict == LinkVerdict::kConsistent || verdict == LinkVerdict::kUnchecked;
+  }
 };
 
 struct LoopSelectionResult {

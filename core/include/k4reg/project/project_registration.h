@@ -1,10 +1,11 @@
 // Project registration: N scans into one frame (after Theiler, Wegner, Schindler 2015), top to bottom:
 //   candidate pairs (candidate_pairs.h)  ->  pairwise K-4PCS per pair, keeping its distinct hypotheses
 //   ->  loop-consistent selection of one hypothesis per link (loop_closure.h)  ->  initial poses by
-//   consensus of the accepted links, from the reference out  ->  global refinement (pose_graph.h), where a
-//   link that disagrees with the refined project is dropped and the rest solved again.
-// A scan that no majority of accepted links places is reported as not registered, never forced into
-// place. Pairs run one after the other, each on all threads, so the result is the same at any thread count.
+//   consensus of the accepted links, from the reference out  ->  each scan's strength (scan_strength.h)
+//   ->  global refinement (pose_graph.h), where a link that disagrees with the refined project is dropped
+//   and the rest solved again.
+// A scan that no majority of accepted links places, or that they hold too weakly to tell it from a
+// symmetric twin, is reported as not registered, never forced into place. Pairs run one after the other, each on all threads, so the result is the same at any thread count.
 // Cost: one pairwise registration per candidate pair (0.2-3 s each at 1 M points on 2 cores); selection and
 // refinement take milliseconds.
 #pragma once
@@ -36,7 +37,7 @@ struct ProjectLink {
   Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();  // the chosen hypothesis (identity when failed)
   // The pairwise result's figures (of its winner); see `candidate` for the hypothesis the loops chose.
   double rmse_m = 0.0, overlap = 0.0, cloud_score = 0.0, ambiguity_margin = 0.0;
-  bool ambiguous = false;
+  bool ambiguous = false, well_supported = false;
   double min_scale_m_used = 0.0, overlap_used = 0.0;
   std::size_t hypotheses = 0;  // distinct candidates the pairwise registration kept
   int candidate = -1;          // the one chosen (0 = the pairwise winner), -1 = none
@@ -54,6 +55,10 @@ struct ProjectScan {
   bool registered = false;
   std::vector<std::size_t> links;  // accepted links touching it (indices into ProjectResult::links)
   std::size_t points = 0;
+  // How firmly the accepted links hold it to the reference beyond what symmetry can copy (scan_strength.h),
+  // capped at 1; under kAmbiguousMargin it is not registered.
+  double strength = 0.0;
+  std::string reason;  // why not registered, in words
 };
 
 struct ProjectResult {
