@@ -20,7 +20,7 @@ namespace {
 struct AlignProjectOptions {
   std::vector<std::string> scans;
   std::string pairs = "all";
-  std::string out_dir;
+  std::string out_dir, write_e57;
   bool json = false;
   ProjectParams params;
 };
@@ -39,8 +39,19 @@ void run_align_project(AlignProjectOptions& o) {
     o.params.pair_list = read_pair_list(o.pairs);
   }
 
+  // A multi-scan E57 or PTX file counts as its scans, each read in its own scanner frame.
   std::vector<PointCloud> clouds;
-  for (const std::string& file : o.scans) clouds.push_back(read_cloud(file));
+  std::vector<ScanOrigin> origins;
+  for (const std::string& file : o.scans) {
+    const std::size_t scans = count_scans(file);
+    for (std::size_t k = 0; k < scans; ++k) {
+      ReadOptions options;
+      if (scans > 1) options.scan_index = k;
+      options.apply_pose = false;
+      clouds.push_back(read_cloud(file, options));
+      origins.push_back({file, scans > 1 ? static_cast<int>(k) : -1});
+    }
+  }
   // Pair by pair on stderr when someone watches; stdout stays the result.
   const bool watched = isatty(STDERR_FILENO);
   const ProjectResult result = register_project(
@@ -49,12 +60,17 @@ void run_align_project(AlignProjectOptions& o) {
         std::cerr << fmt::format("pair {}/{}: scan {} -> {}: {:.1f} s{}\n", index + 1, pairs, link.source, link.target,
                                  link.seconds, link.verdict == "failed" ? " (failed: " + link.reason + ")" : "");
       });
-  const nlohmann::json json = project_to_json(result, o.scans, o.params);
-  if (!o.out_dir.empty()) write_project_dir(o.out_dir, result, o.scans, json);
+  const nlohmann::json json = project_to_json(result, origins, o.params);
+  if (!o.out_dir.empty()) write_project_dir(o.out_dir, result, origins, json);
+  if (!o.write_e57.empty()) {
+    const std::size_t skipped = write_project_e57(o.write_e57, result, clouds, origins);
+    if (skipped > 0)
+      std::cerr << fmt::format("k4reg: {} unregistered scan{} left out of {}\n", skipped, skipped == 1 ? "" : "s", o.write_e57);
+  }
   if (o.json)
     std::cout << json.dump(2) << "\n";
   else
-    print_project_table(std::cout, result, o.scans);
+    print_project_table(std::cout, result, origins);
 }
 
 }  // namespace
@@ -63,7 +79,9 @@ void add_align_project_command(CLI::App& app) {
   auto options = std::make_shared<AlignProjectOptions>();
   CLI::App* command = app.add_subcommand(
       "align-project", "register a project of scans into the frame of one of them, locally (no server)");
-  command->add_option("SCAN", options->scans, "the scans (PLY, PCD, XYZ/TXT/PTS, LAS, PTX, E57), at least 2")
+  command->add_option("SCAN", options->scans,
+                      "the scans (PLY, PCD, XYZ/TXT/PTS, LAS, PTX, E57; a multi-scan E57 or PTX file counts as its "
+                      "scans), at least 2 in all")
       ->required()
       ->check(CLI::ExistingFile);
   add_registration_flags(*command, options->params.pairwise);
@@ -74,6 +92,9 @@ void add_align_project_command(CLI::App& app) {
       ->capture_default_str();
   command->add_flag("--json", options->json, "print the result as JSON");
   command->add_option("--out-dir", options->out_dir, "write NAME.pose.txt per registered scan and project.json here");
+  command->add_option("--write-e57", options->write_e57,
+                      "write every registered scan, in its own frame with its pose, to this E57 file (a registered "
+                      "project for Cyclone, SCENE, ReCap, CloudCompare)");
   command->callback([options] { run_align_project(*options); });
 }
 

@@ -6,18 +6,22 @@
 #include <fstream>
 #include <set>
 
+#include "k4reg/io/e57_io.h"
 #include "k4reg/io/matrix_file.h"
 #include "k4reg/util/error.h"
 #include "result_report.h"
 
 namespace k4reg::cli {
 
-nlohmann::json project_to_json(const ProjectResult& r, const std::vector<std::string>& files, const ProjectParams& params) {
+std::string ScanOrigin::label() const { return scan < 0 ? file : fmt::format("{}#{}", file, scan); }
+
+nlohmann::json project_to_json(const ProjectResult& r, const std::vector<ScanOrigin>& origins, const ProjectParams& params) {
   nlohmann::json j;
   j["scans"] = nlohmann::json::array();
   for (std::size_t i = 0; i < r.scans.size(); ++i) {
     const ProjectScan& s = r.scans[i];
-    j["scans"].push_back({{"file", files.at(i)},
+    j["scans"].push_back({{"file", origins.at(i).file},
+                          {"scan_in_file", origins.at(i).scan},
                           {"pose", s.registered ? matrix_to_json(s.pose) : nlohmann::json(nullptr)},
                           {"registered", s.registered},
                           {"links", s.links},
@@ -63,12 +67,12 @@ nlohmann::json project_to_json(const ProjectResult& r, const std::vector<std::st
   return j;
 }
 
-void print_project_table(std::ostream& out, const ProjectResult& r, const std::vector<std::string>& files) {
+void print_project_table(std::ostream& out, const ProjectResult& r, const std::vector<ScanOrigin>& origins) {
   out << fmt::format("{} of {} scans registered (reference: scan {}, {})\n", r.scans_registered, r.scans.size(),
-                     r.reference, files.at(r.reference));
+                     r.reference, origins.at(r.reference).label());
   for (std::size_t i = 0; i < r.scans.size(); ++i) {
     const ProjectScan& s = r.scans[i];
-    out << fmt::format("scan {} {}: {}\n", i, files.at(i),
+    out << fmt::format("scan {} {}: {}\n", i, origins.at(i).label(),
                        s.registered ? fmt::format("registered (strength {:.3f})", s.strength) : "NOT registered: " + s.reason);
     if (s.registered) out << format_matrix4(s.pose);
   }
@@ -87,7 +91,7 @@ void print_project_table(std::ostream& out, const ProjectResult& r, const std::v
 }
 
 std::vector<std::string> write_project_dir(const std::string& dir, const ProjectResult& r,
-                                           const std::vector<std::string>& files, const nlohmann::json& json) {
+                                           const std::vector<ScanOrigin>& origins, const nlohmann::json& json) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) fail(ErrorCode::kPermissionDenied, dir + ": cannot create the output folder: " + ec.message());
@@ -98,7 +102,9 @@ std::vector<std::string> write_project_dir(const std::string& dir, const Project
       names.emplace_back();
       continue;
     }
-    const std::string stem = std::filesystem::path(files.at(i)).stem().string();
+    const ScanOrigin& origin = origins.at(i);
+    const std::string stem = std::filesystem::path(origin.file).stem().string() +
+                             (origin.scan < 0 ? std::string() : fmt::format("-s{}", origin.scan));
     std::string name = stem + ".pose.txt";
     for (int k = 2; taken.count(name); ++k) name = fmt::format("{}-{}.pose.txt", stem, k);
     taken.insert(name);
@@ -110,6 +116,21 @@ std::vector<std::string> write_project_dir(const std::string& dir, const Project
   out << json.dump(2) << "\n";
   if (!out) fail(ErrorCode::kPermissionDenied, path + ": cannot write");
   return names;
+}
+
+std::size_t write_project_e57(const std::string& path, const ProjectResult& r, const std::vector<PointCloud>& clouds,
+                              const std::vector<ScanOrigin>& origins) {
+  std::vector<E57Scan> scans;
+  for (std::size_t i = 0; i < r.scans.size(); ++i) {
+    if (!r.scans[i].registered) continue;  // no pose to give: left out rather than put at the origin
+    E57Scan scan;
+    scan.name = std::filesystem::path(origins.at(i).label()).filename().string();
+    scan.cloud = clouds.at(i);
+    scan.pose = Eigen::Isometry3d(r.scans[i].pose);
+    scans.push_back(std::move(scan));
+  }
+  write_e57(path, scans);
+  return r.scans.size() - scans.size();
 }
 
 }  // namespace k4reg::cli

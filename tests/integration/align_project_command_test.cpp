@@ -4,6 +4,10 @@
 
 #include <fstream>
 
+#include <Eigen/Geometry>
+
+#include "k4reg/io/cloud_io.h"
+#include "k4reg/io/e57_io.h"
 #include "test_support.h"
 
 namespace k4reg::test {
@@ -45,6 +49,43 @@ TEST(AlignProjectCommand, JsonHasEveryScanAsGivenAndTheOutDirItsPoses) {
     EXPECT_TRUE(fs::exists(dir.path() / "out" / file)) << file;
   std::ifstream saved(dir.path() / "out" / "project.json");
   EXPECT_EQ(nlohmann::json::parse(saved)["scans"], j["scans"]);
+}
+
+// A multi-scan E57 counts as its scans, each registered in its own frame; --write-e57 gives them their poses.
+TEST(AlignProjectCommand, MultiScanE57InAndRegisteredE57Out) {
+  TempDir dir;
+  std::vector<E57Scan> scans;
+  for (const char* name : {"bun000.ply", "bun045.ply", "bun315.ply"}) {
+    E57Scan scan;
+    scan.name = name;
+    scan.cloud = read_cloud(bunny(name));
+    // An instrument pose the project must not apply: each scan in its own frame.
+    scan.pose = Eigen::Translation3d(10.0 * scans.size(), 0, 0) * Eigen::AngleAxisd(0.5 * scans.size(), Eigen::Vector3d::UnitZ());
+    scans.push_back(std::move(scan));
+  }
+  const std::string site = (dir.path() / "site.e57").string(), out = (dir.path() / "registered.e57").string();
+  write_e57(site, scans);
+  const CommandRun run = k4reg(with_flags({"align-project", site, "--json", "--write-e57", out}));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  ASSERT_EQ(j["scans"].size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(j["scans"][k]["file"], site);
+    EXPECT_EQ(j["scans"][k]["scan_in_file"], k);
+    ASSERT_TRUE(j["scans"][k]["registered"].get<bool>());
+  }
+  // The written file: every scan's points as read, placed by the pose the JSON gives.
+  ASSERT_EQ(count_scans(out), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    Eigen::Matrix4d pose;
+    for (int i = 0; i < 16; ++i) pose(i / 4, i % 4) = j["scans"][k]["pose"][i].get<double>();
+    ReadOptions one;
+    one.scan_index = k;
+    const PointCloud placed = read_cloud(out, one);
+    const Eigen::Vector3d local = scans[k].cloud.points[0].cast<double>() + scans[k].cloud.origin_m;
+    const Eigen::Vector3d expected = (pose * local.homogeneous()).head<3>();
+    EXPECT_LT((placed.points[0].cast<double>() + placed.origin_m - expected).norm(), 1e-5) << k;
+  }
 }
 
 TEST(AlignProjectCommand, SequencePairsAndTableOutput) {

@@ -390,6 +390,19 @@ TEST_F(CloudIoTest, PcdAsciiExtraFieldsAndCountAboveOne) {
   EXPECT_FLOAT_EQ(c.intensity[1], 65535.0f);
 }
 
+// PDAL names the coordinates X Y Z.
+TEST_F(CloudIoTest, PcdUpperCaseCoordinateFieldsAndOneScanPerFile) {
+  const std::string p = write_file("pdal.pcd",
+                                   "VERSION 0.7\nFIELDS X Y Z Intensity\nSIZE 8 8 8 2\nTYPE F F F U\nCOUNT 1 1 1 1\n"
+                                   "WIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n"
+                                   "512000.5 5240000.25 300 7\n512001 5240001 301 9\n");
+  const PointCloud c = read_cloud(p);
+  ASSERT_EQ(c.size(), 2u);
+  EXPECT_EQ(world(c, 1), Eigen::Vector3d(512001, 5240001, 301));
+  EXPECT_FLOAT_EQ(c.intensity[0], 7.0f);
+  EXPECT_EQ(count_scans(p), 1u);
+}
+
 std::string binary_pcd_organised(bool compressed) {
   // Organised 3 x 2 cloud; fields: x y z (F4), padding "_" (U1 x 3), normal (F4 x 3), intensity (U1),
   // d (F8). Points 1 and 4 are invalid (NaN), as PCL writes them.

@@ -284,6 +284,14 @@ TEST_F(E57IoTest, SeveralScansWithPosesMergeOrAreSelectedByIndexOrName) {
     ReadOptions by_name;
     by_name.scan_name = "Station ]]> <&> 2";
     EXPECT_LE(max_error(read_cloud(p, by_name), posed(scans[1])), tolerance);
+    // A project reads each scan in its own frame.
+    EXPECT_EQ(count_scans(p), 3u);
+    ReadOptions own_frame;
+    own_frame.scan_index = 1;
+    own_frame.apply_pose = false;
+    std::vector<Eigen::Vector3d> local;
+    for (std::size_t i = 0; i < scans[1].cloud.size(); ++i) local.push_back(world(scans[1].cloud, i));
+    EXPECT_LE(max_error(read_cloud(p, own_frame), local), tolerance);
   }
   const std::string p = path("project.e57");
   ReadOptions bad;

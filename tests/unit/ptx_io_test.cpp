@@ -101,6 +101,11 @@ TEST_F(PtxIoTest, SeveralScansMergeInTheCommonFrameOrOneIsSelected) {
   const PointCloud one = read_cloud(p, second);
   ASSERT_EQ(one.size(), 59u);
   EXPECT_LT((world(one, 0) - expected(1, 0)).norm(), 2e-5);
+  // A project reads each scan in its own frame, the matrix not applied.
+  EXPECT_EQ(count_scans(p), 3u);
+  second.apply_pose = false;
+  EXPECT_LT((world(read_cloud(p, second), 0) - world(scans[1].cloud, 0)).norm(), 2e-5);
+  second.apply_pose = true;
   second.scan_index = 3;
   expect_error([&] { read_cloud(p, second); }, ErrorCode::kInvalidArgument, p, "file has 3 scans");
   ReadOptions named;

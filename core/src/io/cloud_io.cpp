@@ -386,6 +386,21 @@ PointCloud read_cloud(const std::string& path, const ReadOptions& options) {
   return read_cloud_bytes(file.bytes(), path, options);
 }
 
+std::size_t count_scans(const std::string& path) {
+  switch (detect_format(path)) {
+    case CloudFormat::kE57: {
+      io_detail::MappedFile file(path);
+      return count_e57_scans(file.bytes(), path);
+    }
+    case CloudFormat::kPtx: {
+      io_detail::MappedFile file(path);
+      return count_ptx_scans(file.bytes(), path);
+    }
+    default:
+      return 1;
+  }
+}
+
 void write_cloud(const std::string& path, const PointCloud& cloud) {
   const std::string ext = io_detail::lower_extension(path);
   switch (format_from_extension(path)) {

@@ -365,7 +365,7 @@ class ScanDecoder {
                                                 : Eigen::Vector3d(a, b, c);
       if (options.max_points != 0 && points.size() >= options.max_points)
         fail_io(ErrorCode::kResourceExhausted, name_, "more than " + std::to_string(options.max_points) + " points");
-      points.push_back(scan_.pose * p);
+      points.push_back(options.apply_pose ? scan_.pose * p : p);
       if (scan_.intensity >= 0) {
         double v = value(kIntensity, scan_.intensity, k);
         if (scan_.normalise_intensity) v = (v - scan_.intensity_min) / (scan_.intensity_max - scan_.intensity_min);
@@ -394,9 +394,15 @@ class ScanDecoder {
   char packet_[e57::kMaxPacketSize];
 };
 
-}  // namespace
+// An E57 file opened: its pages, its XML and the /data3D entries (at least one). Throws for a damaged file.
+struct OpenedE57 {
+  OpenedE57(std::string_view data, std::uint64_t page_count, const std::string& name) : pages(data, page_count, name) {}
+  e57::PagedReader pages;
+  pugi::xml_document document;
+  std::vector<pugi::xml_node> entries;
+};
 
-PointCloud read_e57_bytes(std::string_view data, const std::string& name, const ReadOptions& options) {
+std::unique_ptr<OpenedE57> open_e57(std::string_view data, const std::string& name) {
   if (data.empty()) fail_io(ErrorCode::kInvalidArgument, name, "empty file");
   if (data.substr(0, 8) != e57::kSignature)
     fail_io(ErrorCode::kInvalidArgument, name, "not an E57 file (wrong magic: no 'ASTM-E57')");
@@ -411,7 +417,8 @@ PointCloud read_e57_bytes(std::string_view data, const std::string& name, const 
     fail_io(ErrorCode::kInvalidArgument, name,
             "truncated: the header declares " + std::to_string(declared) + " bytes, the file has " +
                 std::to_string(data.size()));
-  e57::PagedReader pages(data, declared / e57::kPageSize, name);
+  auto opened = std::make_unique<OpenedE57>(data, declared / e57::kPageSize, name);
+  e57::PagedReader& pages = opened->pages;
   const std::string header = pages.read(0, e57::kFileHeaderSize);  // checks page 0's CRC
   const std::uint32_t major = load_le<std::uint32_t>(header.data() + 8);
   const std::uint64_t page_size = load_le<std::uint64_t>(header.data() + 40);
@@ -425,18 +432,27 @@ PointCloud read_e57_bytes(std::string_view data, const std::string& name, const 
     fail_io(ErrorCode::kInvalidArgument, name, "the XML section is not inside the file");
   const std::string xml = pages.read(xml_logical, static_cast<std::size_t>(xml_length));
 
-  pugi::xml_document document;
+  pugi::xml_document& document = opened->document;
   const pugi::xml_parse_result parsed = document.load_buffer(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
   if (!parsed)
     fail_io(ErrorCode::kInvalidArgument, name,
             std::string("bad XML section: ") + parsed.description() + " at byte " + std::to_string(parsed.offset));
   if (!document.child("e57Root")) fail_io(ErrorCode::kInvalidArgument, name, "the XML has no e57Root element");
   const pugi::xml_node data3d = document.child("e57Root").child("data3D");
-  std::vector<pugi::xml_node> entries;
+  std::vector<pugi::xml_node>& entries = opened->entries;
   for (const pugi::xml_node child : data3d.children())
     if (child.type() == pugi::node_element) entries.push_back(child);
   if (entries.empty()) fail_io(ErrorCode::kInvalidArgument, name, "no scans (/data3D is empty)");
 
+  return opened;
+}
+
+}  // namespace
+
+PointCloud read_e57_bytes(std::string_view data, const std::string& name, const ReadOptions& options) {
+  const std::unique_ptr<OpenedE57> opened = open_e57(data, name);
+  e57::PagedReader& pages = opened->pages;
+  const std::vector<pugi::xml_node>& entries = opened->entries;
   std::vector<std::size_t> selected;
   if (options.scan_index && !options.scan_name.empty())
     fail_io(ErrorCode::kInvalidArgument, name, "select a scan by index or by name, not both");
@@ -497,6 +513,8 @@ PointCloud read_e57_bytes(std::string_view data, const std::string& name, const 
   if (!all_have_intensity) intensity.clear();
   return io_detail::finish_cloud(std::move(points), std::move(intensity), name);
 }
+
+std::size_t count_e57_scans(std::string_view data, const std::string& name) { return open_e57(data, name)->entries.size(); }
 
 PointCloud read_e57(const std::string& path, const ReadOptions& options) {
   io_detail::MappedFile file(path);

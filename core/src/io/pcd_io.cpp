@@ -300,13 +300,14 @@ struct PcdLayout {
 
 PcdLayout find_layout(const PcdHeader& header, const std::string& name) {
   PcdLayout layout;
+  // PDAL writes the coordinates as X Y Z: either case names an axis (the lower case first, if both exist).
   const char* axes[3] = {"x", "y", "z"};
+  const char* upper_axes[3] = {"X", "Y", "Z"};
   for (int a = 0; a < 3; ++a) {
-    for (std::size_t f = 0; f < header.fields.size(); ++f)
-      if (header.fields[f].name == axes[a]) {
-        layout.xyz[a] = static_cast<int>(f);
-        break;
-      }
+    for (const char* axis : {axes[a], upper_axes[a]}) {
+      for (std::size_t f = 0; f < header.fields.size() && layout.xyz[a] < 0; ++f)
+        if (header.fields[f].name == axis) layout.xyz[a] = static_cast<int>(f);
+    }
     if (layout.xyz[a] < 0)
       fail_io(ErrorCode::kInvalidArgument, name, std::string("malformed header: no field '") + axes[a] + "'");
     if (header.fields[layout.xyz[a]].count != 1)

@@ -149,8 +149,9 @@ PointCloud read_ptx_bytes(std::string_view data, const std::string& name, const 
       if (points.capacity() < points.size() + cells) points.reserve(std::max(2 * points.capacity(), points.size() + cells));
     }
     const std::size_t first_point = points.size(), first_intensity = intensity.size();
-    const Eigen::Matrix3d rotation = h.scanner_to_file.topLeftCorner<3, 3>();
-    const Eigen::Vector3d translation = h.scanner_to_file.topRightCorner<3, 1>();
+    const Eigen::Matrix4d to_file = options.apply_pose ? h.scanner_to_file : Eigen::Matrix4d::Identity();
+    const Eigen::Matrix3d rotation = to_file.topLeftCorner<3, 3>();
+    const Eigen::Vector3d translation = to_file.topRightCorner<3, 1>();
     for (std::uint64_t cell = 0; cell < cells; ++cell) {
       if (!lines.next(line))
         fail_io(ErrorCode::kInvalidArgument, name,
@@ -201,6 +202,23 @@ PointCloud read_ptx_bytes(std::string_view data, const std::string& name, const 
                 std::to_string(scans) + " scan" + (scans == 1 ? "" : "s") + " (0-based)");
   if (scans_with_intensity != selected_scans) intensity.clear();
   return io_detail::finish_cloud(std::move(points), std::move(intensity), name);
+}
+
+std::size_t count_ptx_scans(std::string_view data, const std::string& name) {
+  io_detail::LineReader lines(data);
+  std::string_view line;
+  std::size_t scans = 0;
+  for (; skip_blank_lines(lines); ++scans) {
+    ScanHeader h;
+    if (const HeaderProblem problem = parse_header(lines, h); problem.expected)
+      fail_io(ErrorCode::kInvalidArgument, name, "scan " + std::to_string(scans) + " header: expected " + problem.expected);
+    if (!io_detail::mul_fits(h.columns, h.rows, data.size()))
+      fail_io(ErrorCode::kInvalidArgument, name, "truncated: scan " + std::to_string(scans) + " declares more points than bytes");
+    for (std::uint64_t cell = 0; cell < h.columns * h.rows; ++cell)
+      if (!lines.next(line)) fail_io(ErrorCode::kInvalidArgument, name, "truncated: scan " + std::to_string(scans));
+  }
+  if (scans == 0) fail_io(ErrorCode::kInvalidArgument, name, "no scans (only blank lines)");
+  return scans;
 }
 
 PointCloud read_ptx(const std::string& path, const ReadOptions& options) {

@@ -42,6 +42,9 @@ struct ReadOptions {
   // common frame. Setting either for a single-scan format is kInvalidArgument.
   std::optional<std::size_t> scan_index = std::nullopt;
   std::string scan_name = {};
+  // Multi-scan formats: false = each selected scan in its own scanner frame (its E57 pose or PTX matrix not
+  // applied), as a project registers it; other formats ignore it.
+  bool apply_pose = true;
 };
 
 // Format by content (magic bytes: "ply\n"; "LASF"; "ASTM-E57"; PCD header starting "# .PCD", "VERSION" or
@@ -61,6 +64,10 @@ CloudFormat detect_format_bytes(std::string_view data, const std::string& name);
 CloudFormat format_from_extension(const std::string& path);
 
 PointCloud read_cloud(const std::string& path, const ReadOptions& options = {});
+
+// How many scans the file holds: /data3D entries of an E57 file, scans of a PTX file (read through, points
+// unparsed), 1 for every other format. Throws as read_cloud for a file that is not a readable cloud.
+std::size_t count_scans(const std::string& path);
 
 // Reads a cloud from bytes already in memory (uploads). `name` is used for the format hint and messages.
 PointCloud read_cloud_bytes(std::string_view data, const std::string& name, const ReadOptions& options = {});

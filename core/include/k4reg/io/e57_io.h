@@ -36,6 +36,8 @@ namespace k4reg {
 
 PointCloud read_e57(const std::string& path, const ReadOptions& options = {});
 PointCloud read_e57_bytes(std::string_view data, const std::string& name, const ReadOptions& options = {});
+// The number of /data3D entries (the XML is parsed, no point is decoded).
+std::size_t count_e57_scans(std::string_view data, const std::string& name);
 
 // How the writer stores coordinates.
 enum class E57Coordinates {

@@ -31,6 +31,8 @@ namespace k4reg {
 
 PointCloud read_ptx(const std::string& path, const ReadOptions& options = {});
 PointCloud read_ptx_bytes(std::string_view data, const std::string& name, const ReadOptions& options = {});
+// The number of scans (headers parsed and point lines counted, not parsed).
+std::size_t count_ptx_scans(std::string_view data, const std::string& name);
 
 // True when the text starts like a PTX scan header (two integer lines, four lines of 3 numbers, four of 4).
 bool looks_like_ptx(std::string_view data);
