@@ -11,6 +11,7 @@
 #include "command_error.h"
 #include "k4reg/io/cloud_io.h"
 #include "k4reg/project/project_registration.h"
+#include "project_flags.h"
 #include "project_report.h"
 #include "registration_flags.h"
 
@@ -19,9 +20,8 @@ namespace {
 
 struct AlignProjectOptions {
   std::vector<std::string> scans;
-  std::string pairs = "all";
-  std::string out_dir, write_e57;
-  bool json = false;
+  std::string write_e57;
+  ProjectFlags flags;
   ProjectParams params;
 };
 
@@ -30,14 +30,7 @@ void run_align_project(AlignProjectOptions& o) {
   for (const std::string& file : o.scans)
     if (!seen.insert(std::filesystem::weakly_canonical(file).string()).second)
       throw CommandError(fmt::format("{} is given twice: each scan once", file));
-  if (o.pairs == "all")
-    o.params.pairs = PairSelection::kAll;
-  else if (o.pairs == "sequence")
-    o.params.pairs = PairSelection::kSequence;
-  else {
-    o.params.pairs = PairSelection::kList;
-    o.params.pair_list = read_pair_list(o.pairs);
-  }
+  apply_pairs(o.flags, o.params);
 
   // A multi-scan E57 or PTX file counts as its scans, each read in its own scanner frame.
   std::vector<PointCloud> clouds;
@@ -57,17 +50,18 @@ void run_align_project(AlignProjectOptions& o) {
   const ProjectResult result = register_project(
       clouds, o.params, nullptr, {}, [&](const ProjectLink& link, std::size_t index, std::size_t pairs) {
         if (!watched) return;
-        std::cerr << fmt::format("pair {}/{}: scan {} -> {}: {:.1f} s{}\n", index + 1, pairs, link.source, link.target,
-                                 link.seconds, link.verdict == "failed" ? " (failed: " + link.reason + ")" : "");
+        std::cerr << pair_line(index, pairs, link.source, link.target, link.seconds,
+                               link.verdict == "failed" ? link.reason : "")
+                  << "\n";
       });
   const nlohmann::json json = project_to_json(result, origins, o.params);
-  if (!o.out_dir.empty()) write_project_dir(o.out_dir, result, origins, json);
+  if (!o.flags.out_dir.empty()) write_project_dir(o.flags.out_dir, result, origins, json);
   if (!o.write_e57.empty()) {
     const std::size_t skipped = write_project_e57(o.write_e57, result, clouds, origins);
     if (skipped > 0)
       std::cerr << fmt::format("k4reg: {} unregistered scan{} left out of {}\n", skipped, skipped == 1 ? "" : "s", o.write_e57);
   }
-  if (o.json)
+  if (o.flags.json)
     std::cout << json.dump(2) << "\n";
   else
     print_project_table(std::cout, result, origins);
@@ -85,13 +79,7 @@ void add_align_project_command(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   add_registration_flags(*command, options->params.pairwise);
-  command->add_option("--reference", options->params.reference, "0-based index of the scan whose pose is the identity")
-      ->capture_default_str();
-  command->add_option("--pairs", options->pairs,
-                      "which pairs to register: all, sequence (each scan with the next two), or a file of index pairs")
-      ->capture_default_str();
-  command->add_flag("--json", options->json, "print the result as JSON");
-  command->add_option("--out-dir", options->out_dir, "write NAME.pose.txt per registered scan and project.json here");
+  add_project_flags(*command, options->flags, options->params);
   command->add_option("--write-e57", options->write_e57,
                       "write every registered scan, in its own frame with its pose, to this E57 file (a registered "
                       "project for Cyclone, SCENE, ReCap, CloudCompare)");

@@ -11,6 +11,7 @@
 #include "health_command.h"
 #include "load_command.h"
 #include "register_command.h"
+#include "register_project_command.h"
 #endif
 
 int main(int argc, char** argv) {
@@ -20,6 +21,7 @@ int main(int argc, char** argv) {
   k4reg::cli::add_align_project_command(app);
 #ifdef K4REG_REMOTE_COMMANDS
   k4reg::cli::add_register_command(app);
+  k4reg::cli::add_register_project_command(app);
   k4reg::cli::add_health_command(app);
   k4reg::cli::add_load_command(app);
 #endif

@@ -29,24 +29,21 @@ BodyKind body_kind(const httplib::Request& request) {
        "unsupported Content-Type '" + type + "': send application/json or multipart/form-data");
 }
 
-// Inline clouds travel base64-encoded in JSON (4 characters per 3 bytes).
-std::uint64_t json_limit(const ServiceContext& service) {
-  return (service.max_inline_bytes + 2) / 3 * 4 + kJsonOverheadBytes;
-}
 
 std::uint64_t multipart_limit(const ServiceContext& service) { return 2 * service.max_upload_bytes + kFormOverheadBytes; }
 
-// Queues the job like the RPCs do and waits for it on this (cpp-httplib) thread. `queue_full` tells a full
-// queue (429) from the other RESOURCE_EXHAUSTED refusals (413).
-grpc::Status run_and_wait(const ServiceContext& service, const CloudSource& source, const CloudSource& target,
-                          const RegistrationParams& params, CallClock& clock, RequestRecord& record,
-                          v1::RegisterResponse& reply, bool& queue_full) {
+}  // namespace
+
+std::uint64_t json_body_limit(const ServiceContext& service) {
+  return (service.max_inline_bytes + 2) / 3 * 4 + kJsonOverheadBytes;
+}
+
+grpc::Status run_and_wait(const ServiceContext& service, CallClock& clock, const std::function<grpc::Status(Job&)>& work,
+                          bool& queue_full) {
   // Owned by the job as well: the worker may still be inside set_value when this thread wakes up.
   auto done = std::make_shared<std::promise<grpc::Status>>();
   std::future<grpc::Status> finished = done->get_future();
-  auto job = std::make_shared<Job>([&, done](Job& self) {
-    done->set_value(run_job(service, self, source, target, params, {}, clock, record, reply));
-  });
+  auto job = std::make_shared<Job>([&work, done](Job& self) { done->set_value(work(self)); });
   clock.enqueued = CallClock::Clock::now();
   std::size_t position = 0;
   if (const grpc::Status status = service.submit(job, position); !status.ok()) {
@@ -57,13 +54,11 @@ grpc::Status run_and_wait(const ServiceContext& service, const CloudSource& sour
   return finished.get();
 }
 
-}  // namespace
-
 grpc::Status check_register_headers(const ServiceContext& service, const httplib::Request& request) {
   if (grpc::Status status = service.admit(authorization_header(request)); !status.ok()) return status;
   try {
     const bool multipart = body_kind(request) == BodyKind::kMultipart;
-    const std::uint64_t limit = multipart ? multipart_limit(service) : json_limit(service);
+    const std::uint64_t limit = multipart ? multipart_limit(service) : json_body_limit(service);
     const std::uint64_t declared = request.get_header_value<std::uint64_t>("Content-Length");
     if (declared > limit)
       fail(ErrorCode::kResourceExhausted,
@@ -88,7 +83,7 @@ void handle_register(const ServiceContext& service, HttpExchange& exchange) {
   CloudSource source, target;
   try {
     if (body_kind(exchange.request) == BodyKind::kJson) {
-      from_json(exchange.body.read_all(json_limit(service)), request);
+      from_json(exchange.body.read_all(json_body_limit(service)), request);
       params = params_from_proto(request.params());
       source = service.cloud_source(request.source(), "source");
       target = service.cloud_source(request.target(), "target");
@@ -106,7 +101,10 @@ void handle_register(const ServiceContext& service, HttpExchange& exchange) {
   }
   v1::RegisterResponse reply;
   bool queue_full = false;
-  const grpc::Status status = run_and_wait(service, source, target, params, clock, exchange.record, reply, queue_full);
+  const grpc::Status status = run_and_wait(
+      service, clock,
+      [&](Job& job) { return run_job(service, job, source, target, params, {}, clock, exchange.record, reply); },
+      queue_full);
   if (!status.ok()) {
     exchange.fail(status, queue_full);
     return;

@@ -6,6 +6,9 @@
 #pragma once
 
 #include <grpcpp/support/status.h>
+
+#include <functional>
+
 #include "http_lib.h"
 
 #include "http_exchange.h"
@@ -18,5 +21,14 @@ namespace k4reg::service {
 grpc::Status check_register_headers(const ServiceContext& service, const httplib::Request& request);
 
 void handle_register(const ServiceContext& service, HttpExchange& exchange);
+
+// The largest JSON body: --max-inline-mb of clouds, base64-encoded (4 characters per 3 bytes), and the JSON
+// around them.
+std::uint64_t json_body_limit(const ServiceContext& service);
+
+// Queues `work` like the RPCs queue their jobs and waits for it on this (cpp-httplib) thread. `queue_full`
+// tells a full queue (429) from the other RESOURCE_EXHAUSTED refusals (413).
+grpc::Status run_and_wait(const ServiceContext& service, CallClock& clock, const std::function<grpc::Status(Job&)>& work,
+                          bool& queue_full);
 
 }  // namespace k4reg::service

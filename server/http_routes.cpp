@@ -3,6 +3,7 @@
 #include "grpc/health/v1/health.pb.h"
 #include "http_json.h"
 #include "http_register.h"
+#include "http_register_project.h"
 #include "metrics.h"
 
 namespace k4reg::service {
@@ -45,6 +46,7 @@ void handle_metrics(const ServiceContext& service, HttpExchange& exchange) {
 
 constexpr HttpRoute kRoutes[] = {
     {"POST", "/v1/register", false, check_register_headers, handle_register},
+    {"POST", "/v1/register-project", false, check_register_headers, handle_register_project},
     {"GET", "/v1/version", false, nullptr, handle_version},
     {"GET", "/healthz", true, nullptr, handle_healthz},
     {"GET", "/readyz", true, nullptr, handle_readyz},

@@ -13,9 +13,9 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
-// Reader messages start with the path they were given; clients should see their own name instead of a
-// server path (data root or spool file).
-PointCloud load(const CloudSource& source, const ReadOptions& options) {
+}  // namespace
+
+PointCloud load_cloud(const CloudSource& source, const ReadOptions& options) {
   try {
     if (source.file.empty()) return read_cloud_bytes(source.bytes, source.name, options);
     return read_cloud(source.file, options);
@@ -28,32 +28,19 @@ PointCloud load(const CloudSource& source, const ReadOptions& options) {
   }
 }
 
-// The core reports (stage, fraction) with 0 at a stage's start and 1 at its end (a stage may report 1
-// twice); listeners get explicit phases.
-class StageTracker {
- public:
-  explicit StageTracker(const StageListener& listener) : listener_(listener) {}
-  void operator()(const std::string& stage, double fraction) {
-    if (!listener_) return;
-    if (stage != stage_) {
-      stage_ = stage;
-      finished_ = false;
-      listener_(stage, v1::StageEvent::PHASE_STARTED, 0.0);
-      if (fraction <= 0.0) return;
-    }
-    if (finished_) return;
-    finished_ = fraction >= 1.0;
-    listener_(stage, finished_ ? v1::StageEvent::PHASE_FINISHED : v1::StageEvent::PHASE_PROGRESS,
-              std::clamp(fraction, 0.0, 1.0));
+void StageTracker::operator()(const std::string& stage, double fraction) {
+  if (!listener_) return;
+  if (stage != stage_) {
+    stage_ = stage;
+    finished_ = false;
+    listener_(stage, v1::StageEvent::PHASE_STARTED, 0.0);
+    if (fraction <= 0.0) return;
   }
-
- private:
-  const StageListener& listener_;
-  std::string stage_;
-  bool finished_ = false;
-};
-
-}  // namespace
+  if (finished_) return;
+  finished_ = fraction >= 1.0;
+  listener_(stage, finished_ ? v1::StageEvent::PHASE_FINISHED : v1::StageEvent::PHASE_PROGRESS,
+            std::clamp(fraction, 0.0, 1.0));
+}
 
 RegistrationResult run_registration(const CloudSource& source, const CloudSource& target, RegistrationParams params,
                                     const JobLimits& limits, MemoryBudget& memory, const CancellationToken& token,
@@ -64,10 +51,10 @@ RegistrationResult run_registration(const CloudSource& source, const CloudSource
   const auto load_start = Clock::now();
   progress("load", 0.0);
   const ReadOptions options{limits.max_points};
-  const PointCloud source_cloud = load(source, options);
+  const PointCloud source_cloud = load_cloud(source, options);
   report.source_points = source_cloud.size();
   token.throw_if_stopped();
-  const PointCloud target_cloud = load(target, options);
+  const PointCloud target_cloud = load_cloud(target, options);
   report.target_points = target_cloud.size();
   progress("load", 1.0);
   report.load_s = seconds_since(load_start);

@@ -7,6 +7,7 @@
 #include <string>
 #include <string_view>
 
+#include "k4reg/io/cloud_io.h"
 #include "k4reg/util/cancellation.h"
 #include "k4reg/registration/registration.h"
 #include "k4reg/v1/registration.pb.h"
@@ -34,6 +35,22 @@ struct JobReport {
 
 // Stage events for progress streams: "load", then the core's stages. Called on the worker thread.
 using StageListener = std::function<void(const std::string& stage, v1::StageEvent::Phase phase, double fraction)>;
+
+// The core reports (stage, fraction) with 0 at a stage's start and 1 at its end (a stage may report 1
+// twice); listeners get explicit phases.
+class StageTracker {
+ public:
+  explicit StageTracker(const StageListener& listener) : listener_(listener) {}
+  void operator()(const std::string& stage, double fraction);
+
+ private:
+  const StageListener& listener_;
+  std::string stage_;
+  bool finished_ = false;
+};
+
+// Reads a cloud; error messages name it as the client did (never a server path). Throws k4reg::Error.
+PointCloud load_cloud(const CloudSource& source, const ReadOptions& options);
 
 // Throws k4reg::Error (kCancelled / kDeadlineExceeded once the token fires).
 RegistrationResult run_registration(const CloudSource& source, const CloudSource& target, RegistrationParams params,

@@ -1,5 +1,6 @@
 #include "registration_service.h"
 
+#include "project_reactor.h"
 #include "register_reactor.h"
 #include "stream_reactor.h"
 
@@ -15,6 +16,11 @@ grpc::ServerUnaryReactor* RegistrationService::Register(grpc::CallbackServerCont
 grpc::ServerBidiReactor<v1::RegisterStreamRequest, v1::RegisterStreamResponse>* RegistrationService::RegisterStream(
     grpc::CallbackServerContext* context) {
   return new StreamReactor(context_, context);
+}
+
+grpc::ServerWriteReactor<v1::RegisterProjectEvent>* RegistrationService::RegisterProject(
+    grpc::CallbackServerContext* context, const v1::RegisterProjectRequest* request) {
+  return new ProjectReactor(context_, context, request);
 }
 
 }  // namespace k4reg::service

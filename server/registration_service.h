@@ -15,6 +15,8 @@ class RegistrationService final : public v1::Registration::CallbackService {
                                      v1::RegisterResponse* reply) override;
   grpc::ServerBidiReactor<v1::RegisterStreamRequest, v1::RegisterStreamResponse>* RegisterStream(
       grpc::CallbackServerContext* context) override;
+  grpc::ServerWriteReactor<v1::RegisterProjectEvent>* RegisterProject(grpc::CallbackServerContext* context,
+                                                                     const v1::RegisterProjectRequest* request) override;
 
  private:
   ServiceContext context_;

@@ -11,8 +11,6 @@ namespace {
 
 constexpr const char* kDraining = "server is draining; retry on another replica";
 
-double seconds(CallClock::Clock::duration d) { return std::chrono::duration<double>(d).count(); }
-
 }  // namespace
 
 grpc::Status ServiceContext::admit(const grpc::ServerContextBase& context) const {
@@ -89,15 +87,18 @@ void apply_deadline(const grpc::ServerContextBase& context, CancellationToken& t
                          deadline - std::chrono::system_clock::now()));
 }
 
-void decorate_reply(const ServiceContext& service, const CallClock& clock, const JobReport& report,
-                    const std::string& request_id, v1::RegisterResponse& reply) {
-  v1::ServerTimings& t = *reply.mutable_timings();
+void fill_timings(const CallClock& clock, double load_s, double registration_s, v1::ServerTimings& t) {
   t.set_queue_wait_s(seconds(clock.job_start - clock.enqueued));
   t.set_request_to_job_start_s(seconds(clock.job_start - clock.call_start));
   t.set_upload_s(seconds(clock.upload_end - clock.upload_start));
-  t.set_load_s(report.load_s);
-  t.set_registration_s(report.registration_s);
+  t.set_load_s(load_s);
+  t.set_registration_s(registration_s);
   t.set_job_end_to_reply_s(seconds(CallClock::Clock::now() - clock.job_end));
+}
+
+void decorate_reply(const ServiceContext& service, const CallClock& clock, const JobReport& report,
+                    const std::string& request_id, v1::RegisterResponse& reply) {
+  fill_timings(clock, report.load_s, report.registration_s, *reply.mutable_timings());
   *reply.mutable_server() = service.server_info;
   reply.set_request_id(request_id);
 }

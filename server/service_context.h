@@ -59,6 +59,11 @@ struct CallClock {
   Clock::time_point call_start = Clock::now(), upload_start, upload_end, enqueued, job_start, job_end;
 };
 
+inline double seconds(CallClock::Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+// The ServerTimings of a job that ran on `clock`; call just before the reply leaves.
+void fill_timings(const CallClock& clock, double load_s, double registration_s, v1::ServerTimings& timings);
+
 // Fills timings, server info and request id of a successful reply; call just before handing it to gRPC.
 void decorate_reply(const ServiceContext& service, const CallClock& clock, const JobReport& report,
                     const std::string& request_id, v1::RegisterResponse& reply);

@@ -10,13 +10,11 @@ namespace k4reg::service {
 namespace {
 
 constexpr std::size_t kMaxChunkBytes = 1 << 20;
-// Progress events between a stage's start and end are rate-limited; starts and ends always go out.
-constexpr auto kProgressInterval = std::chrono::milliseconds(100);
 
 }  // namespace
 
 StreamReactor::StreamReactor(ServiceContext& service, grpc::CallbackServerContext* context)
-    : service_(service), context_(context) {
+    : JobStreamReactor(service), context_(context) {
   record_ = open_request(*context, "/k4reg.v1.Registration/RegisterStream");
   if (const grpc::Status status = service_.admit(*context); !status.ok()) {
     finish(status);
@@ -118,30 +116,12 @@ void StreamReactor::read_next_or_start_job() {
     return;
   }
   clock_.upload_end = CallClock::Clock::now();
-  auto job = std::make_shared<Job>([this](Job& j) { execute(j); });
-  apply_deadline(*context_, job->token());
-  grpc::Status status;
-  {
-    // Held across submit(): a worker that picks the job up at once posts its first stage event only after
-    // the queued event.
-    std::lock_guard lock(mutex_);
-    if (cancelled_) job->token().cancel();  // OnCancel came before there was a job to cancel
-    job_ = job;
-    clock_.enqueued = CallClock::Clock::now();
-    std::size_t position = 0;
-    status = service_.submit(job, position);
-    if (status.ok()) {
-      v1::RegisterStreamResponse queued;
-      queued.mutable_queued()->set_position(static_cast<std::uint32_t>(position));
-      post_locked(std::move(queued));
-    }
-  }
-  if (!status.ok()) finish(status);
+  start_job(*context_, clock_, [this](Job& job) { execute(job); });
 }
 
 void StreamReactor::execute(Job& job) {
   const StageListener listener = [this](const std::string& stage, v1::StageEvent::Phase phase, double fraction) {
-    post_stage(stage, phase, fraction);
+    post_stage(stage, phase, fraction, clock_.job_start);
   };
   v1::RegisterStreamResponse reply;
   const grpc::Status status =
@@ -150,84 +130,13 @@ void StreamReactor::execute(Job& job) {
   finish(status);
 }
 
-void StreamReactor::post_stage(const std::string& stage, v1::StageEvent::Phase phase, double fraction) {
-  const auto now = CallClock::Clock::now();
-  if (phase == v1::StageEvent::PHASE_PROGRESS) {
-    std::lock_guard lock(mutex_);
-    if (now - last_progress_ < kProgressInterval) return;
-    last_progress_ = now;
-  }
-  v1::RegisterStreamResponse message;
-  v1::StageEvent& event = *message.mutable_stage();
-  event.set_stage(stage);
-  event.set_phase(phase);
-  event.set_fraction(fraction);
-  event.set_elapsed_s(std::chrono::duration<double>(now - clock_.job_start).count());
-  post(std::move(message));
-}
-
-void StreamReactor::post(v1::RegisterStreamResponse message) {
-  std::lock_guard lock(mutex_);
-  post_locked(std::move(message));
-}
-
-void StreamReactor::post_locked(v1::RegisterStreamResponse message) {
-  if (write_failed_ || final_status_) return;
-  outbox_.push_back(std::move(message));
-  if (writing_) return;
-  writing_ = true;
-  StartWrite(&outbox_.front());  // a deque keeps the front in place while later messages are added
-}
-
-void StreamReactor::OnWriteDone(bool ok) {
-  grpc::Status status;
-  {
-    std::lock_guard lock(mutex_);
-    outbox_.pop_front();
-    writing_ = false;
-    if (!ok) {  // the call is broken (cancelled); nothing more will be delivered
-      write_failed_ = true;
-      outbox_.clear();
-    }
-    if (!outbox_.empty()) {
-      writing_ = true;
-      StartWrite(&outbox_.front());
-      return;
-    }
-    if (!final_status_ || finished_) return;
-    finished_ = true;
-    status = *final_status_;
-  }
-  Finish(status);
-}
-
-void StreamReactor::finish(const grpc::Status& status) {
-  {
-    std::lock_guard lock(mutex_);
-    if (final_status_) return;
-    final_status_ = status;
-    // Nothing reads the spool files any more (no job and no read in flight at any call of finish), and the
-    // client should not see its status before they are gone.
-    for (Upload& upload : uploads_) upload.file.reset();
-    record_.code = status.error_code();
-    record_.error = status.error_message();
-    service_.end_request(record_);  // before the status leaves: a client that got its answer finds the log line
-    if (writing_) return;  // OnWriteDone finishes once the outbox is empty
-    finished_ = true;
-  }
-  Finish(status);
-}
-
-void StreamReactor::OnCancel() {
-  std::shared_ptr<Job> job;
-  {
-    std::lock_guard lock(mutex_);
-    cancelled_ = true;
-    job = job_;
-  }
-  if (!job) return;  // still uploading: the pending read fails and finishes the call
-  job->token().cancel();
-  if (service_.withdraw(job.get())) finish({grpc::StatusCode::CANCELLED, "cancelled while queued"});
+void StreamReactor::on_finishing(const grpc::Status& status) {
+  // Nothing reads the spool files any more (no job and no read in flight at any call of finish), and the
+  // client should not see its status before they are gone.
+  for (Upload& upload : uploads_) upload.file.reset();
+  record_.code = status.error_code();
+  record_.error = status.error_message();
+  service_.end_request(record_);  // before the status leaves: a client that got its answer finds the log line
 }
 
 void StreamReactor::OnDone() { delete this; }

@@ -2,30 +2,27 @@
 // the job; progress events and the result go back on the same call.
 //
 // Threads: reads and their reactions run on gRPC threads (appending a <= 1 MiB chunk to a spool file is
-// quick); the job runs on a worker, which posts events. Writes are serialised through an outbox because
-// gRPC allows one write in flight; Finish waits until the outbox is empty.
+// quick); the job runs on a worker, which posts events through the outbox (job_stream_reactor.h).
 #pragma once
 
 #include <grpcpp/support/server_callback.h>
 
 #include <array>
-#include <deque>
 #include <memory>
-#include <mutex>
-#include <optional>
 
+#include "job_stream_reactor.h"
 #include "request_log.h"
 #include "service_context.h"
 
 namespace k4reg::service {
 
-class StreamReactor final : public grpc::ServerBidiReactor<v1::RegisterStreamRequest, v1::RegisterStreamResponse> {
+class StreamReactor final
+    : public JobStreamReactor<grpc::ServerBidiReactor<v1::RegisterStreamRequest, v1::RegisterStreamResponse>,
+                              v1::RegisterStreamResponse> {
  public:
   StreamReactor(ServiceContext& service, grpc::CallbackServerContext* context);
 
   void OnReadDone(bool ok) override;
-  void OnWriteDone(bool ok) override;
-  void OnCancel() override;
   void OnDone() override;
 
  private:
@@ -44,12 +41,8 @@ class StreamReactor final : public grpc::ServerBidiReactor<v1::RegisterStreamReq
   void read_next_or_start_job();
   void execute(Job& job);  // on a worker
 
-  void post(v1::RegisterStreamResponse message);  // any thread
-  void post_locked(v1::RegisterStreamResponse message);  // with mutex_ held
-  void post_stage(const std::string& stage, v1::StageEvent::Phase phase, double fraction);
-  void finish(const grpc::Status& status);  // any thread; once the outbox is empty
+  void on_finishing(const grpc::Status& status) override;
 
-  ServiceContext& service_;
   grpc::CallbackServerContext* context_;
   RequestRecord record_;
   CallClock clock_;
@@ -58,14 +51,6 @@ class StreamReactor final : public grpc::ServerBidiReactor<v1::RegisterStreamReq
   RegistrationParams params_;
   CloudSource source_, target_;
   std::array<Upload, 2> uploads_;  // source, target
-
-  std::mutex mutex_;  // guards everything below
-  std::shared_ptr<Job> job_;
-  bool cancelled_ = false;
-  std::deque<v1::RegisterStreamResponse> outbox_;  // front is in flight while writing_
-  bool writing_ = false, write_failed_ = false, finished_ = false;
-  std::optional<grpc::Status> final_status_;
-  CallClock::Clock::time_point last_progress_;
 };
 
 }  // namespace k4reg::service

@@ -164,8 +164,10 @@ TEST_F(HttpApi, OpenApiSchemasMatchTheProtoMessages) {
   }
   // Every message of the API's JSON bodies.
   EXPECT_EQ(checked, (std::set<std::string>{"CloudInput", "HealthCheckResponse", "Hypothesis", "InlineCloud",
-                                            "RegisterRequest", "RegisterResponse", "RegistrationParams",
-                                            "RegistrationResult", "ServerInfo", "ServerTimings", "StageTiming"}));
+                                            "ProjectLink", "ProjectParams", "ProjectResult", "ProjectScan",
+                                            "RegisterProjectRequest", "RegisterProjectResponse", "RegisterRequest",
+                                            "RegisterResponse", "RegistrationParams", "RegistrationResult", "ScanPair",
+                                            "ServerInfo", "ServerTimings", "StageTiming"}));
 }
 
 TEST_F(HttpApi, JsonRegistrationIsIdenticalToGrpc) {

@@ -104,6 +104,25 @@ def main():
             print(f"registered bun045 -> bun000 on {reply.server.server_id}: rmse {result.rmse_m:.5f} m, "
                   f"translation error {translation_error * 1000:.2f} mm")
 
+            # A project: three scans into bun000's frame, events as they come, the result last.
+            project = registration_pb2.RegisterProjectRequest(
+                scans=[registration_pb2.CloudInput(path=name) for name in ("bun000.ply", "bun045.ply", "bun315.ply")],
+                params=registration_pb2.ProjectParams(
+                    pairwise=registration_pb2.RegistrationParams(min_scale_m=0.002, overlap=0.5, seed=1)))
+            pairs, final = 0, None
+            for event in stub.RegisterProject(project, timeout=180):
+                kind = event.WhichOneof("event")
+                pairs += kind == "pair"
+                if kind == "result":
+                    final = event.result.result
+            assert pairs == 3 and final is not None, (pairs, final)
+            assert [scan.registered for scan in final.scans] == [True, True, True], final.scans
+            assert list(final.scans[0].pose) == [1.0, 0, 0, 0, 0, 1.0, 0, 0, 0, 0, 1.0, 0, 0, 0, 0, 1.0]
+            truth = read_ground_truth(args.data_dir, "bun045.ply", "bun000.ply")
+            pose = final.scans[1].pose
+            assert math.dist([pose[i] for i in (3, 7, 11)], [truth[i] for i in (3, 7, 11)]) < 0.002, list(pose)
+            print(f"project of 3 scans: {final.scans_registered} registered, global rmse {final.global_rmse_m:.5f} m")
+
             try:
                 stub.Register(registration_pb2.RegisterRequest(
                     source=registration_pb2.CloudInput(path="../bunny/bun045.ply"),

@@ -1,0 +1,34 @@
+#include "project_flags.h"
+
+#include <fmt/format.h>
+
+namespace k4reg::cli {
+
+void add_project_flags(CLI::App& command, ProjectFlags& flags, ProjectParams& params) {
+  flags.reference = command.add_option("--reference", params.reference, "0-based index of the scan whose pose is the identity")
+                        ->capture_default_str();
+  command.add_option("--pairs", flags.pairs,
+                     "which pairs to register: all, sequence (each scan with the next two), or a file of index pairs")
+      ->capture_default_str();
+  command.add_flag("--json", flags.json, "print the result as JSON");
+  command.add_option("--out-dir", flags.out_dir, "write NAME.pose.txt per registered scan and project.json here");
+}
+
+void apply_pairs(const ProjectFlags& flags, ProjectParams& params) {
+  if (flags.pairs == "all") {
+    params.pairs = PairSelection::kAll;
+  } else if (flags.pairs == "sequence") {
+    params.pairs = PairSelection::kSequence;
+  } else {
+    params.pairs = PairSelection::kList;
+    params.pair_list = read_pair_list(flags.pairs);
+  }
+}
+
+std::string pair_line(std::size_t index, std::size_t pairs, std::size_t source, std::size_t target, double seconds,
+                      const std::string& error) {
+  return fmt::format("pair {}/{}: scan {} -> {}: {:.1f} s{}", index + 1, pairs, source, target, seconds,
+                     error.empty() ? "" : " (failed: " + error + ")");
+}
+
+}  // namespace k4reg::cli

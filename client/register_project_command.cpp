@@ -1,0 +1,119 @@
+#include "register_project_command.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <iostream>
+#include <memory>
+
+#include "channel.h"
+#include "command_error.h"
+#include "k4reg/v1/registration.grpc.pb.h"
+#include "local_file.h"
+#include "project_flags.h"
+#include "project_mapping.h"
+#include "project_report.h"
+#include "proto_mapping.h"
+#include "registration_flags.h"
+#include "server_timings.h"
+#include "status_text.h"
+
+namespace k4reg::cli {
+namespace {
+
+struct RegisterProjectOptions {
+  std::vector<std::string> scans;
+  bool by_reference = false;
+  double deadline_s = 0;
+  std::string request_id;
+  ConnectionOptions connection;
+  ProjectParams params;
+  RegistrationFlags registration{};
+  ProjectFlags flags;
+};
+
+v1::RegisterProjectRequest make_request(const RegisterProjectOptions& o, ProjectParams& params) {
+  apply_pairs(o.flags, params);
+  v1::RegisterProjectRequest request;
+  for (const std::string& scan : o.scans) {
+    v1::CloudInput& input = *request.add_scans();
+    if (o.by_reference) {
+      input.set_path(scan);
+    } else {
+      input.mutable_inline_cloud()->set_data(read_local_file(scan));  // within the server's --max-inline-mb
+      input.mutable_inline_cloud()->set_file_name(scan);
+    }
+  }
+  v1::ProjectParams& p = *request.mutable_params();
+  *p.mutable_pairwise() = params_to_proto(params.pairwise, o.registration);
+  if (o.flags.reference->count() > 0) p.set_reference(static_cast<std::uint32_t>(params.reference));
+  p.set_pairs(params.pairs == PairSelection::kAll        ? v1::PAIR_SELECTION_ALL
+              : params.pairs == PairSelection::kSequence ? v1::PAIR_SELECTION_SEQUENCE
+                                                         : v1::PAIR_SELECTION_LIST);
+  for (const auto& [first, second] : params.pair_list) {
+    v1::ScanPair& pair = *p.add_pair_list();
+    pair.set_first(static_cast<std::uint32_t>(first));
+    pair.set_second(static_cast<std::uint32_t>(second));
+  }
+  return request;
+}
+
+void run_register_project(const RegisterProjectOptions& o) {
+  ProjectParams params = o.params;
+  const v1::RegisterProjectRequest request = make_request(o, params);
+  const auto channel = make_channel(o.connection);
+  auto stub = v1::Registration::NewStub(channel);
+  grpc::ClientContext context;
+  add_call_metadata(context, o.connection, o.request_id.empty() ? new_request_id() : o.request_id);
+  if (o.deadline_s > 0) context.set_deadline(deadline_after(o.deadline_s));
+  // Queue position and each finished pair on stderr, as align-project prints them; stdout stays the result.
+  const bool watched = isatty(STDERR_FILENO);
+  v1::RegisterProjectResponse response;
+  auto reader = stub->RegisterProject(&context, request);
+  for (v1::RegisterProjectEvent event; reader->Read(&event);) {
+    if (event.has_result()) response = event.result();
+    if (!watched) continue;
+    if (event.has_queued()) std::cerr << fmt::format("queued: {} jobs ahead\n", event.queued().position());
+    if (event.has_pair()) {
+      const v1::PairEvent& pair = event.pair();
+      std::cerr << pair_line(pair.index(), pair.pairs(), pair.source(), pair.target(), pair.seconds(), pair.error()) << "\n";
+    }
+  }
+  if (const grpc::Status status = reader->Finish(); !status.ok())
+    throw CommandError(describe_failure(status, *channel, o.connection.server));
+
+  const ProjectResult result = project_result_from_proto(response.result());
+  std::vector<ScanOrigin> origins;
+  for (const std::string& scan : o.scans) origins.push_back({scan, -1});
+  nlohmann::json json = project_to_json(result, origins, params);
+  json["request_id"] = response.request_id();
+  json["server"] = {{"version", response.server().version()}, {"server_id", response.server().server_id()}};
+  json["server_timings"] = server_timings_to_json(response.timings());
+  if (!o.flags.out_dir.empty()) write_project_dir(o.flags.out_dir, result, origins, json);
+  if (o.flags.json)
+    std::cout << json.dump(2) << "\n";
+  else
+    print_project_table(std::cout, result, origins);
+}
+
+}  // namespace
+
+void add_register_project_command(CLI::App& app) {
+  auto options = std::make_shared<RegisterProjectOptions>();
+  CLI::App* command = app.add_subcommand(
+      "register-project",
+      "register a project of scans on a k4reg server: local files are sent inline (the server's --max-inline-mb\n"
+      "bounds them all together), or with --ref named on the server. Parameter flags not given are not sent.");
+  command->add_option("SCAN", options->scans, "the scans: local files, or with --ref paths on the server")->required();
+  add_connection_flags(*command, options->connection);
+  options->registration = add_registration_flags(*command, options->params.pairwise);
+  add_project_flags(*command, options->flags, options->params);
+  command->add_flag("--ref", options->by_reference, "the scans are paths under the server's --data-root, nothing is sent");
+  command->add_option("--deadline", options->deadline_s, "give up after this many seconds; 0 = never")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  command->add_option("--request-id", options->request_id, "x-request-id of the call (default: a new UUID)");
+  command->callback([options] { run_register_project(*options); });
+}
+
+}  // namespace k4reg::cli

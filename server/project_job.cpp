@@ -1,0 +1,97 @@
+#include "project_job.h"
+
+#include <chrono>
+
+#include <fmt/format.h>
+
+#include <set>
+
+#include "k4reg/util/error.h"
+#include "project_convert.h"
+#include "status_mapping.h"
+
+namespace k4reg::service {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+}  // namespace
+
+ProjectResult run_project(const std::vector<CloudSource>& scans, ProjectParams params, const JobLimits& limits,
+                          MemoryBudget& memory, const CancellationToken& token, const StageListener& stages,
+                          const PairListener& pairs, ProjectReport& report) {
+  token.throw_if_stopped();  // cancelled or expired while queued
+  StageTracker progress(stages);
+  const auto load_start = Clock::now();
+  progress("load", 0.0);
+  std::vector<PointCloud> clouds;
+  for (const CloudSource& scan : scans) {
+    clouds.push_back(load_cloud(scan, ReadOptions{limits.max_points}));
+    report.points += clouds.back().size();
+    progress("load", static_cast<double>(clouds.size()) / scans.size());
+    token.throw_if_stopped();
+  }
+  progress("load", 1.0);
+  report.load_s = seconds_since(load_start);
+
+  // Every scan stays in memory for the whole project; one pair at a time works on two of them.
+  const MemoryBudget::Reservation reservation = memory.reserve(kBytesPerPoint * report.points, token);
+  if (params.pairwise.threads == 0 || params.pairwise.threads > limits.job_threads) params.pairwise.threads = limits.job_threads;
+  const auto start = Clock::now();
+  const ProgressCallback callback = [&](const std::string& stage, double fraction) { progress(stage, fraction); };
+  ProjectResult result = register_project(clouds, params, &token, callback, pairs);
+  report.registration_s = seconds_since(start);
+  return result;
+}
+
+ProjectJob project_job_from_proto(const ServiceContext& service, const v1::RegisterProjectRequest& request) {
+  ProjectJob job;
+  job.params = project_params_from_proto(request.params());
+  if (request.scans_size() < 2)
+    fail(ErrorCode::kInvalidArgument, fmt::format("a project needs at least 2 scans, got {}", request.scans_size()));
+  std::set<std::string> files;
+  for (int i = 0; i < request.scans_size(); ++i) {
+    const std::string role = fmt::format("scan {}", i);
+    CloudSource scan = service.cloud_source(request.scans(i), role.c_str());
+    if (!scan.file.empty() && !files.insert(scan.file).second)
+      fail(ErrorCode::kInvalidArgument, fmt::format("{} ({}) is given twice: each scan once", role, scan.name));
+    job.names.push_back(scan.name);
+    job.scans.push_back(std::move(scan));
+  }
+  if (job.params.reference >= job.scans.size())
+    fail(ErrorCode::kInvalidArgument, fmt::format("params.reference {} is out of range: the project has {} scans",
+                                                  job.params.reference, job.scans.size()));
+  return job;
+}
+
+grpc::Status run_project_job(const ServiceContext& service, Job& job, const ProjectJob& project, const StageListener& stages,
+                             const PairListener& pairs, CallClock& clock, RequestRecord& record,
+                             v1::RegisterProjectResponse& reply) {
+  clock.job_start = CallClock::Clock::now();
+  ProjectReport report;
+  grpc::Status status;
+  try {
+    const ProjectResult result =
+        run_project(project.scans, project.params, service.limits, service.memory, job.token(), stages, pairs, report);
+    project_result_to_proto(result, project.names, reply.mutable_result());
+  } catch (...) {
+    status = status_from_current_exception();
+  }
+  clock.job_end = CallClock::Clock::now();
+  record.source_points = report.points;
+  record.queue_wait_s = seconds(clock.job_start - clock.enqueued);
+  record.registration_s = report.registration_s;
+  service.metrics.observe_job(record.queue_wait_s, seconds(clock.job_end - clock.job_start), report.points);
+  if (status.error_code() == grpc::StatusCode::CANCELLED || status.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED)
+    service.metrics.job_cancelled();
+  if (status.ok()) {
+    fill_timings(clock, report.load_s, report.registration_s, *reply.mutable_timings());
+    *reply.mutable_server() = service.server_info;
+    reply.set_request_id(record.request_id);
+  }
+  return status;
+}
+
+}  // namespace k4reg::service

@@ -1,0 +1,31 @@
+// RegisterProject (server streaming): the request names or carries every scan; the job runs on a worker,
+// which posts the queued event, stage events ("load", "pairs", "selection", "refinement"), one event per
+// registered pair, and finally the result, through the outbox (job_stream_reactor.h).
+#pragma once
+
+#include <memory>
+
+#include "job_stream_reactor.h"
+#include "project_job.h"
+#include "request_log.h"
+#include "service_context.h"
+
+namespace k4reg::service {
+
+class ProjectReactor final
+    : public JobStreamReactor<grpc::ServerWriteReactor<v1::RegisterProjectEvent>, v1::RegisterProjectEvent> {
+ public:
+  ProjectReactor(ServiceContext& service, grpc::CallbackServerContext* context, const v1::RegisterProjectRequest* request);
+
+  void OnDone() override;
+
+ private:
+  void execute(Job& job);  // on a worker
+  void on_finishing(const grpc::Status& status) override;
+
+  RequestRecord record_;
+  CallClock clock_;
+  ProjectJob project_;
+};
+
+}  // namespace k4reg::service
