@@ -12,6 +12,7 @@
 #include "k4reg/geometry/sampling.h"
 #include "k4reg/project/loop_closure.h"
 #include "k4reg/project/pose_graph.h"
+#include "k4reg/project/scan_conflicts.h"
 #include "k4reg/project/scan_strength.h"
 #include "k4reg/util/error.h"
 
@@ -40,8 +41,6 @@ double scan_radius_m(const PointCloud& cloud) {
   return std::max(half, centre.norm() + half);
 }
 
-// What a true link's transform can be off by: its fine-scale error, or the scale it was found at.
-double link_tolerance_m(const ProjectLink& link) { return std::max(2.0 * link.min_scale_m_used, link.rmse_m); }
 
 // The pose of scan `scan` that a link to an already placed scan proposes.
 Eigen::Matrix4d proposed_pose(const ProjectResult& r, const ProjectLink& link, std::size_t scan) {
@@ -106,6 +105,8 @@ void reject(ProjectResult& r, std::size_t l, const std::string& reason) {
 }
 
 }  // namespace
+
+double link_tolerance_m(const ProjectLink& link) { return std::max(2.0 * link.min_scale_m_used, link.rmse_m); }
 
 ProjectResult register_project(const std::vector<PointCloud>& scans, const ProjectParams& params,
                                const CancellationToken* cancel, const ProgressCallback& progress,
@@ -248,25 +249,8 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
       graph.push_back({link.source, link.target, link.transform, radius[link.source], 1.0});
       tolerances.push_back(link_tolerance_m(link));
     }
-    // A confident pairwise result (unambiguous, well supported) that the loops did not accept and that the
-    //    placement contradicts leaves its two scans in doubt: the evidence is in conflict, and a symmetric
-    //    object seen from the other side can outvote the truth with confident wrong links. Both leave the
-    //    project (the reference stays).
-    for (std::size_t l = 0; l < r.links.size(); ++l) {
-      const ProjectLink& link = r.links[l];
-      if (link.accepted || link.verdict == "failed" || link.ambiguous || !link.well_supported) continue;
-      if (!r.scans[link.source].registered || !r.scans[link.target].registered) continue;
-      const double misfit = displacement_m(link_misfit(r.scans[link.source].pose, r.scans[link.target].pose, link.transform),
-                                           radius[link.source]);
-      if (misfit <= kLoopToleranceFactor * link_tolerance_m(link)) continue;
-      for (std::size_t scan : {link.source, link.target})
-        if (scan != r.reference && r.scans[scan].reason.empty())
-          r.scans[scan].reason = fmt::format(
-              "in conflict: link {} ({} -> {}), a confident pairwise result, puts it {:.3g} m from where the other links do",
-              l, link.source, link.target, misfit);
-    }
-    for (ProjectScan& scan : r.scans)
-      if (scan.registered && !scan.reason.empty()) scan.registered = false;
+    // Scans that a confident pairwise result contradicts leave the project (scan_conflicts.h).
+    refuse_conflicted_scans(r, radius);
     // Scans held too weakly to tell from a symmetric twin leave the project, with their links.
     std::vector<WeightedLink> weighted;
     for (std::size_t l : used) weighted.push_back({r.links[l].source, r.links[l].target, strength_weight(r.links[l])});

@@ -71,6 +71,10 @@ struct ProjectResult {
   std::vector<StageTiming> timings;  // pairwise stages summed over pairs, then "selection", "refinement"
 };
 
+// What a true link's transform can be off by (metres of scan displacement): its fine-scale error, or twice
+// the scale it was found at.
+double link_tolerance_m(const ProjectLink& link);
+
 // Called after each pair: the link as registered (before selection), its index and the number of pairs.
 using PairCallback = std::function<void(const ProjectLink& link, std::size_t index, std::size_t pairs)>;
 

@@ -1,0 +1,20 @@
+// Scans whose placement a confident pairwise result contradicts. A link whose pairwise verdict was
+// unambiguous and well supported, that the loops did not accept, and that puts its two placed scans further
+// apart than its tolerance (kLoopToleranceFactor x link_tolerance_m) leaves both in doubt: the evidence is in
+// conflict, and nothing says which side is right. A front/back-symmetric object seen from the back can
+// outvote the truth with such links, consistent among themselves; refusing both scans of every contradicted
+// confident link keeps them from being registered confidently wrong.
+// Cost: O(links).
+#pragma once
+
+#include <vector>
+
+#include "k4reg/project/project_registration.h"
+
+namespace k4reg {
+
+// Clears `registered` and sets `reason` on every such scan but the reference. scan_radius_m: per scan, its
+// radius about its frame's origin (weighs a rotation misfit, as in the loops).
+void refuse_conflicted_scans(ProjectResult& result, const std::vector<double>& scan_radius_m);
+
+}  // namespace k4reg

@@ -1,0 +1,64 @@
+// A confident pairwise result that the project contradicts refuses both of its scans (never the reference);
+// doubtful, accepted or agreeing links refuse nothing.
+#include <gtest/gtest.h>
+
+#include "k4reg/geometry/rigid_motion.h"
+#include "k4reg/project/scan_conflicts.h"
+
+namespace k4reg {
+namespace {
+
+Eigen::Matrix4d shifted(double x) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m(0, 3) = x;
+  return m;
+}
+
+// Three placed scans along x; links 0 -> 1, 1 -> 2 (accepted) and 0 -> 2 (rejected), all agreeing.
+ProjectResult placed_project() {
+  ProjectResult r;
+  r.scans.resize(3);
+  for (std::size_t i = 0; i < 3; ++i) r.scans[i].registered = true, r.scans[i].pose = shifted(2.0 * i);
+  for (auto [s, t, accepted] : {std::tuple{0, 1, true}, std::tuple{1, 2, true}, std::tuple{0, 2, false}}) {
+    ProjectLink link;
+    link.source = s, link.target = t, link.accepted = accepted;
+    link.transform = rigid_inverse(r.scans[t].pose) * r.scans[s].pose;
+    link.well_supported = true;
+    link.verdict = accepted ? "confirmed" : "contradicted";
+    link.min_scale_m_used = 0.05;  // tolerance 3 x 0.1 m
+    r.links.push_back(link);
+  }
+  return r;
+}
+
+TEST(ScanConflicts, AgreeingLinksRefuseNothing) {
+  ProjectResult r = placed_project();
+  refuse_conflicted_scans(r, std::vector<double>(3, 10.0));
+  for (const ProjectScan& s : r.scans) EXPECT_TRUE(s.registered);
+}
+
+TEST(ScanConflicts, ConfidentRejectedLinkThatDisagreesRefusesBothScansButTheReference) {
+  ProjectResult r = placed_project();
+  r.links[2].transform = shifted(1.0) * r.links[2].transform;  // 1 m off, confident
+  refuse_conflicted_scans(r, std::vector<double>(3, 10.0));
+  EXPECT_TRUE(r.scans[0].registered);  // the reference
+  EXPECT_TRUE(r.scans[1].registered);
+  EXPECT_FALSE(r.scans[2].registered);
+  EXPECT_NE(r.scans[2].reason.find("link 2 (0 -> 2)"), std::string::npos) << r.scans[2].reason;
+}
+
+TEST(ScanConflicts, DoubtfulOrAcceptedOrSmallMisfitsRefuseNothing) {
+  for (int variant = 0; variant < 4; ++variant) {
+    ProjectResult r = placed_project();
+    ProjectLink& link = r.links[2];
+    link.transform = shifted(variant == 3 ? 0.2 : 1.0) * link.transform;  // 0.2 m: within 0.3 m
+    if (variant == 0) link.ambiguous = true;
+    if (variant == 1) link.well_supported = false;
+    if (variant == 2) link.accepted = true;
+    refuse_conflicted_scans(r, std::vector<double>(3, 10.0));
+    for (const ProjectScan& s : r.scans) EXPECT_TRUE(s.registered) << variant;
+  }
+}
+
+}  // namespace
+}  // namespace k4reg
