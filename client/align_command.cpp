@@ -3,10 +3,12 @@
 #include <Eigen/LU>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "k4reg/io/cloud_io.h"
 #include "k4reg/io/matrix_file.h"
 #include "k4reg/registration/metrics.h"
+#include "qa_report.h"
 #include "registration_flags.h"
 #include "result_report.h"
 
@@ -19,6 +21,7 @@ struct AlignOptions {
   bool json = false;
   double success_rmse_m = kIndoorSuccessRmse_m;
   RegistrationParams params;
+  ReportFlags report;
 };
 
 // A number selects a scan by its 0-based index, anything else by its name.
@@ -39,25 +42,26 @@ void run_align(const AlignOptions& o) {
   if (!o.out.empty()) write_matrix4(o.out, result.transform);
 
   nlohmann::json json = result_to_json(result);
+  std::optional<std::pair<TransformError, bool>> checked;  // against ground truth: the error, and success
   if (!o.gt_source.empty()) {
     // Ground truth maps each scan into the scene: source -> target is inv(G_target) * G_source.
     const Eigen::Matrix4d truth = read_matrix4(o.gt_target).inverse() * read_matrix4(o.gt_source);
     Eigen::Matrix4d shift = Eigen::Matrix4d::Identity();  // the metrics take the source's local points
     shift.topRightCorner<3, 1>() = source.origin_m;
     const TransformError error = transform_error(source.points, result.transform * shift, truth * shift);
-    const bool success = registration_succeeded(error, o.success_rmse_m);
-    if (o.json) {
-      json["ground_truth"] = error_to_json(error, success);
-    } else {
-      print_result_table(std::cout, result);
-      print_error_table(std::cout, error, success);
-      return;
-    }
+    checked.emplace(error, registration_succeeded(error, o.success_rmse_m));
+    json["ground_truth"] = error_to_json(error, checked->second);
   }
-  if (o.json)
+  if (o.report.wanted()) {
+    const CloudPreview preview = make_pair_preview(source, target, result, o.report.preview());
+    write_pair_report(o.report, "k4reg align", o.source, o.target, o.params, json, &preview);
+  }
+  if (o.json) {
     std::cout << json.dump(2) << "\n";
-  else
-    print_result_table(std::cout, result);
+    return;
+  }
+  print_result_table(std::cout, result);
+  if (checked) print_error_table(std::cout, checked->first, checked->second);
 }
 
 }  // namespace
@@ -73,6 +77,7 @@ void add_align_command(CLI::App& app) {
   add_registration_flags(*align, options->params);
   align->add_flag("--json", options->json, "print the result as JSON");
   align->add_option("--out", options->out, "write the 4x4 source->target matrix to this file");
+  add_report_flags(*align, options->report);
   auto* gs = align->add_option("--gt-source", options->gt_source, "ground truth of the source (simulator .gt.txt)")
                  ->check(CLI::ExistingFile);
   auto* gt = align->add_option("--gt-target", options->gt_target, "ground truth of the target")->check(CLI::ExistingFile);

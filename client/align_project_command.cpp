@@ -13,6 +13,7 @@
 #include "k4reg/project/project_registration.h"
 #include "project_flags.h"
 #include "project_report.h"
+#include "qa_report.h"
 #include "registration_flags.h"
 
 namespace k4reg::cli {
@@ -23,6 +24,7 @@ struct AlignProjectOptions {
   std::string write_e57;
   ProjectFlags flags;
   ProjectParams params;
+  ReportFlags report;
 };
 
 void run_align_project(AlignProjectOptions& o) {
@@ -61,6 +63,12 @@ void run_align_project(AlignProjectOptions& o) {
     if (skipped > 0)
       std::cerr << fmt::format("k4reg: {} unregistered scan{} left out of {}\n", skipped, skipped == 1 ? "" : "s", o.write_e57);
   }
+  if (o.report.wanted()) {
+    std::vector<std::string> labels;
+    for (const ScanOrigin& origin : origins) labels.push_back(origin.label());
+    const CloudPreview preview = make_project_preview(clouds, labels, result, o.report.preview());
+    write_project_report(o.report, "k4reg align-project", labels, o.params, json, &preview);
+  }
   if (o.flags.json)
     std::cout << json.dump(2) << "\n";
   else
@@ -83,6 +91,7 @@ void add_align_project_command(CLI::App& app) {
   command->add_option("--write-e57", options->write_e57,
                       "write every registered scan, in its own frame with its pose, to this E57 file (a registered "
                       "project for Cyclone, SCENE, ReCap, CloudCompare)");
+  add_report_flags(*command, options->report);
   command->callback([options] { run_align_project(*options); });
 }
 

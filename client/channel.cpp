@@ -109,6 +109,8 @@ std::string channel_target(const std::string& server) {
 std::shared_ptr<grpc::Channel> make_channel(const ConnectionOptions& options) {
   grpc::ChannelArguments arguments;
   arguments.SetLoadBalancingPolicyName("round_robin");
+  // A reply with a preview of the largest size (kMaxPreviewPoints, 32 MB, plus keypoints) must get through.
+  arguments.SetMaxReceiveMessageSize(kMaxReplyBytes);
   std::shared_ptr<grpc::ChannelCredentials> credentials;
   if (options.tls || !options.ca_cert.empty()) {
     grpc::SslCredentialsOptions ssl;

@@ -28,6 +28,9 @@ std::string channel_target(const std::string& server);
 
 // One channel per command with the round_robin policy, so calls spread over every address of the target
 // (the list, or all addresses a DNS name resolves to) instead of sticking to the first.
+// The largest reply a channel receives: a preview of kMaxPreviewPoints (32 MB) with room for the rest.
+inline constexpr int kMaxReplyBytes = 64 << 20;
+
 std::shared_ptr<grpc::Channel> make_channel(const ConnectionOptions& options);
 
 // Token and request id metadata; `request_id` may be empty (the server then generates one).

@@ -1,5 +1,10 @@
 #include "proto_mapping.h"
 
+#include <fmt/format.h>
+
+#include <bit>
+#include <cstring>
+
 #include "command_error.h"
 
 namespace k4reg::cli {
@@ -53,6 +58,46 @@ Eigen::Matrix4d matrix_from_proto(const google::protobuf::RepeatedField<double>&
   return m;
 }
 
+std::vector<Eigen::Vector3d> points_from_proto(const google::protobuf::RepeatedField<double>& values) {
+  if (values.size() % 3 != 0)
+    throw CommandError(fmt::format("the server sent {} point coordinates, not a multiple of 3", values.size()));
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < values.size(); i += 3) points.emplace_back(values[i], values[i + 1], values[i + 2]);
+  return points;
+}
+
+namespace {
+
+// Little-endian float32 values, `width` per item; a length that is not a whole number of items is a bad reply.
+template <typename T>
+std::vector<T> floats_from_bytes(const std::string& bytes, const char* what) {
+  static_assert(std::endian::native == std::endian::little, "the API's previews are little-endian float32");
+  if (bytes.size() % sizeof(T) != 0)
+    throw CommandError(fmt::format("the server's preview has {} bytes of {}, not whole values", bytes.size(), what));
+  std::vector<T> values(bytes.size() / sizeof(T));
+  std::memcpy(static_cast<void*>(values.data()), bytes.data(), bytes.size());
+  return values;
+}
+
+}  // namespace
+
+CloudPreview preview_from_proto(const v1::Preview& m) {
+  CloudPreview preview;
+  if (m.offset_m_size() == 3) preview.offset_m = Eigen::Vector3d(m.offset_m(0), m.offset_m(1), m.offset_m(2));
+  preview.distance_cap_m = m.distance_cap_m();
+  for (const v1::PreviewCloud& c : m.clouds()) {
+    PreviewCloud& cloud = preview.clouds.emplace_back();
+    cloud.name = c.name();
+    cloud.points = c.points();
+    cloud.xyz = floats_from_bytes<Eigen::Vector3f>(c.xyz(), "xyz");
+    cloud.distance_m = floats_from_bytes<float>(c.distance_m(), "distance_m");
+    cloud.keypoints = floats_from_bytes<Eigen::Vector3f>(c.keypoints_xyz(), "keypoints_xyz");
+    if (cloud.distance_m.size() != cloud.xyz.size())
+      throw CommandError("the server's preview of " + cloud.name + " has not one distance per point");
+  }
+  return preview;
+}
+
 RegistrationResult result_from_proto(const v1::RegistrationResult& m) {
   RegistrationResult r;
   r.transform = matrix_from_proto(m.transform());
@@ -73,7 +118,8 @@ RegistrationResult result_from_proto(const v1::RegistrationResult& m) {
   r.overlap_used = m.overlap_used();
   for (const v1::Hypothesis& h : m.hypotheses())
     r.hypotheses.push_back({matrix_from_proto(h.transform()), h.keypoint_score(), h.cloud_score(), h.refined_score(),
-                            h.surface_agreement()});
+                            h.surface_agreement(), points_from_proto(h.base_source_m()),
+                            points_from_proto(h.base_target_m())});
   r.bases_tried = m.bases_tried();
   r.seed = m.seed();
   r.icp_converged = m.icp_converged();

@@ -9,6 +9,7 @@
 #include "channel.h"
 #include "k4reg/io/matrix_file.h"
 #include "progress_bar.h"
+#include "qa_report.h"
 #include "proto_mapping.h"
 #include "registration_flags.h"
 #include "remote_registration.h"
@@ -26,6 +27,7 @@ struct RegisterOptions {
   ConnectionOptions connection;
   RegistrationParams params;
   RegistrationFlags flags{};
+  ReportFlags report;
 };
 
 void print_server_table(std::ostream& out, const v1::RegisterResponse& response) {
@@ -38,7 +40,8 @@ void print_server_table(std::ostream& out, const v1::RegisterResponse& response)
 }
 
 void run_register(const RegisterOptions& o) {
-  const RemoteRegistration job{o.source, o.target, o.by_reference, params_to_proto(o.params, o.flags)};
+  const RemoteRegistration job{o.source, o.target, o.by_reference, params_to_proto(o.params, o.flags),
+                               o.report.wanted() ? static_cast<std::uint32_t>(o.report.preview_points) : 0u};
   const CallPolicy policy{o.deadline_s, o.retries, o.request_id.empty() ? new_request_id() : o.request_id};
   v1::RegisterResponse response;
   {
@@ -48,12 +51,16 @@ void run_register(const RegisterOptions& o) {
   }
   const RegistrationResult result = result_from_proto(response.result());
   if (!o.out.empty()) write_matrix4(o.out, result.transform);
+  // align's layout, plus where and how the job ran.
+  nlohmann::json json = result_to_json(result);
+  json["request_id"] = response.request_id();
+  json["server"] = {{"version", response.server().version()}, {"server_id", response.server().server_id()}};
+  json["server_timings"] = server_timings_to_json(response.timings());
+  if (o.report.wanted()) {
+    const CloudPreview preview = preview_from_proto(response.preview());
+    write_pair_report(o.report, "k4reg register", o.source, o.target, o.params, json, &preview);
+  }
   if (o.json) {
-    // align's layout, plus where and how the job ran.
-    nlohmann::json json = result_to_json(result);
-    json["request_id"] = response.request_id();
-    json["server"] = {{"version", response.server().version()}, {"server_id", response.server().server_id()}};
-    json["server_timings"] = server_timings_to_json(response.timings());
     std::cout << json.dump(2) << "\n";
   } else {
     print_result_table(std::cout, result);
@@ -87,6 +94,7 @@ void add_register_command(CLI::App& app) {
       ->check(CLI::Range(0, 100));
   command->add_option("--request-id", options->request_id, "x-request-id of the call (default: a new UUID)");
   command->add_flag("--progress", options->progress, "draw the progress bar even when stderr is not a terminal");
+  add_report_flags(*command, options->report);
   command->callback([options] { run_register(*options); });
 }
 

@@ -13,6 +13,7 @@
 #include "project_flags.h"
 #include "project_mapping.h"
 #include "project_report.h"
+#include "qa_report.h"
 #include "proto_mapping.h"
 #include "registration_flags.h"
 #include "server_timings.h"
@@ -30,6 +31,7 @@ struct RegisterProjectOptions {
   ProjectParams params;
   RegistrationFlags registration{};
   ProjectFlags flags;
+  ReportFlags report;
 };
 
 v1::RegisterProjectRequest make_request(const RegisterProjectOptions& o, ProjectParams& params) {
@@ -60,7 +62,8 @@ v1::RegisterProjectRequest make_request(const RegisterProjectOptions& o, Project
 
 void run_register_project(const RegisterProjectOptions& o) {
   ProjectParams params = o.params;
-  const v1::RegisterProjectRequest request = make_request(o, params);
+  v1::RegisterProjectRequest request = make_request(o, params);
+  if (o.report.wanted()) request.set_preview_points(static_cast<std::uint32_t>(o.report.preview_points));
   const auto channel = make_channel(o.connection);
   auto stub = v1::Registration::NewStub(channel);
   grpc::ClientContext context;
@@ -90,6 +93,10 @@ void run_register_project(const RegisterProjectOptions& o) {
   json["server"] = {{"version", response.server().version()}, {"server_id", response.server().server_id()}};
   json["server_timings"] = server_timings_to_json(response.timings());
   if (!o.flags.out_dir.empty()) write_project_dir(o.flags.out_dir, result, origins, json);
+  if (o.report.wanted()) {
+    const CloudPreview preview = preview_from_proto(response.preview());
+    write_project_report(o.report, "k4reg register-project", o.scans, params, json, &preview);
+  }
   if (o.flags.json)
     std::cout << json.dump(2) << "\n";
   else
@@ -113,6 +120,7 @@ void add_register_project_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   command->add_option("--request-id", options->request_id, "x-request-id of the call (default: a new UUID)");
+  add_report_flags(*command, options->report);
   command->callback([options] { run_register_project(*options); });
 }
 

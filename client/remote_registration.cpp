@@ -103,6 +103,7 @@ v1::RegisterResponse register_remote(const std::shared_ptr<grpc::Channel>& chann
                                      RegistrationObserver& observer) {
   v1::UploadHeader header;
   *header.mutable_params() = job.params;
+  header.set_preview_points(job.preview_points);
   std::vector<std::pair<v1::CloudRole, LocalFile>> uploads;
   if (job.by_reference) {
     header.mutable_source()->set_path(job.source);

@@ -15,6 +15,7 @@ struct RemoteRegistration {
   std::string source, target;  // local files to upload, or with by_reference paths under the server's data roots
   bool by_reference = false;
   v1::RegistrationParams params;
+  std::uint32_t preview_points = 0;  // > 0: the response carries a preview of the registered clouds
 };
 
 struct CallPolicy {

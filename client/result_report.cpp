@@ -13,6 +13,12 @@ nlohmann::json matrix_to_json(const Eigen::Matrix4d& m) {
   return rows;  // row-major, 16 numbers
 }
 
+nlohmann::json points_to_json(const std::vector<Eigen::Vector3d>& points) {
+  nlohmann::json values = nlohmann::json::array();
+  for (const Eigen::Vector3d& p : points) values.insert(values.end(), {p.x(), p.y(), p.z()});
+  return values;  // x, y, z of each point in turn
+}
+
 nlohmann::json result_to_json(const RegistrationResult& r) {
   nlohmann::json j;
   j["transform"] = matrix_to_json(r.transform);
@@ -42,7 +48,9 @@ nlohmann::json result_to_json(const RegistrationResult& r) {
          {"keypoint_score", h.keypoint_score},
          {"cloud_score", h.cloud_score},
          {"refined_score", h.refined_score},
-         {"surface_agreement", h.surface_agreement}});
+         {"surface_agreement", h.surface_agreement},
+         {"base_source_m", points_to_json(h.base_source_m)},
+         {"base_target_m", points_to_json(h.base_target_m)}});
   j["timings"] = timings_to_json(r.timings);
   return j;
 }

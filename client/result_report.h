@@ -13,6 +13,9 @@ namespace k4reg::cli {
 // A 4x4 matrix as 16 numbers, row-major (the API's layout).
 nlohmann::json matrix_to_json(const Eigen::Matrix4d& m);
 
+// Points as 3 numbers each, one after the other (the API's layout).
+nlohmann::json points_to_json(const std::vector<Eigen::Vector3d>& points);
+
 nlohmann::json result_to_json(const RegistrationResult& result);
 // Stage timings: [{"stage", "seconds"}], and as indented lines with their total.
 nlohmann::json timings_to_json(const std::vector<StageTiming>& timings);

@@ -12,6 +12,7 @@ IMAGE_PACKAGES=(
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc grpc-proto
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libcpp-httplib-dev libssl-dev
   libgtest-dev libgmock-dev
+  libjs-three  # three.js r111, compiled into the QA report and the server's page (web/)
 )
 PACKAGES=(
   "${IMAGE_PACKAGES[@]}" git ca-certificates
@@ -20,6 +21,7 @@ PACKAGES=(
   prometheus
   gnuplot-nox yamllint python3-yaml docker-compose curl openssl ccache
   clang libclang-rt-14-dev llvm  # sanitizer and fuzz builds; llvm has llvm-symbolizer for their reports
+  chromium chromium-driver python3-selenium  # tests/browser: the report and the page in headless Chromium
 )
 
 case "${1:-}" in

@@ -64,12 +64,29 @@ void HttpExchange::fail(const grpc::Status& status, int http_status) {
   reply(http_status, error_json(status, record.request_id), kJsonContentType);
 }
 
+void HttpExchange::stream(const char* content_type, std::function<bool(std::string& line)> next,
+                          std::function<void(bool)> on_end) {
+  streaming_ = true;
+  response.status = 200;
+  response.set_chunked_content_provider(
+      content_type,
+      [next = std::move(next)](std::size_t, httplib::DataSink& sink) {
+        std::string line;
+        if (!next(line)) {
+          sink.done();
+          return true;
+        }
+        return sink.write(line.data(), line.size());
+      },
+      std::move(on_end));
+}
+
 void HttpExchange::end() {
   body.discard_rest();
   if (!body.complete()) close_after_answer(response);
   if (body.is_multipart()) record.upload_bytes = body.bytes_received();  // uploaded clouds, as for RegisterStream
   record.http_status = response.status;
-  service_.end_request(record);
+  if (!streaming_) service_.end_request(record);
 }
 
 void HttpExchange::end_before_body() {

@@ -8,6 +8,7 @@
 #include "http_lib.h"
 
 #include <atomic>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -32,6 +33,10 @@ class HttpExchange {
   // The error answer {code, message, request_id}: HTTP status from status_mapping (429 with Retry-After).
   void fail(const grpc::Status& status, bool queue_full = false);
   void fail(const grpc::Status& status, int http_status);
+  // 200 with a chunked body: the lines `next` gives (on this connection's thread, after the handler returns)
+  // until it returns false. `on_end` runs when the answer ends (true: delivered; false: the client went away)
+  // and writes the access-log line itself: end() then leaves it out.
+  void stream(const char* content_type, std::function<bool(std::string& line)> next, std::function<void(bool)> on_end);
 
   // Consumes what is left of the body (closing the connection after the answer if it does not end), then
   // writes the access-log line and the metrics. Call once the answer is set.
@@ -47,6 +52,7 @@ class HttpExchange {
 
  private:
   const ServiceContext& service_;
+  bool streaming_ = false;
 };
 
 // The "authorization" header, nullopt without one.

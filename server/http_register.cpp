@@ -5,6 +5,7 @@
 #include <future>
 #include <memory>
 
+#include "http_event_stream.h"
 #include "http_json.h"
 #include "http_upload.h"
 #include "k4reg/util/error.h"
@@ -30,7 +31,12 @@ BodyKind body_kind(const httplib::Request& request) {
 }
 
 
-std::uint64_t multipart_limit(const ServiceContext& service) { return 2 * service.max_upload_bytes + kFormOverheadBytes; }
+// Pairs: two files; projects: at most kMaxProjectUploads files' worth of --max-upload-mb in one body.
+constexpr std::uint64_t kMaxProjectUploads = 64;
+std::uint64_t multipart_limit(const ServiceContext& service, const httplib::Request& request) {
+  const std::uint64_t files = request.path == "/v1/register-project" ? kMaxProjectUploads : 2;
+  return files * service.max_upload_bytes + kFormOverheadBytes;
+}
 
 }  // namespace
 
@@ -58,13 +64,13 @@ grpc::Status check_register_headers(const ServiceContext& service, const httplib
   if (grpc::Status status = service.admit(authorization_header(request)); !status.ok()) return status;
   try {
     const bool multipart = body_kind(request) == BodyKind::kMultipart;
-    const std::uint64_t limit = multipart ? multipart_limit(service) : json_body_limit(service);
+    const std::uint64_t limit = multipart ? multipart_limit(service, request) : json_body_limit(service);
     const std::uint64_t declared = request.get_header_value<std::uint64_t>("Content-Length");
     if (declared > limit)
       fail(ErrorCode::kResourceExhausted,
            fmt::format("request body of {} bytes, more than the {} limit of {} bytes ({})", declared,
                        multipart ? "multipart" : "JSON", limit,
-                       multipart ? "2 files of --max-upload-mb" : "--max-inline-mb of base64 clouds"));
+                       multipart ? "the files' --max-upload-mb" : "--max-inline-mb of base64 clouds"));
   } catch (...) {
     return status_from_current_exception();
   }
@@ -76,34 +82,57 @@ void handle_register(const ServiceContext& service, HttpExchange& exchange) {
     exchange.fail(status);
     return;
   }
+  // What the job reads, owned by the job when the answer streams (the handler returns before it runs).
+  struct Call {
+    v1::RegisterRequest request;  // owns inline cloud bytes
+    UploadForm form;              // owns spool files
+    RegistrationParams params;
+    CloudSource source, target;
+    std::size_t preview_points = 0;
+  };
+  auto call = std::make_shared<Call>();
   CallClock clock;
-  v1::RegisterRequest request;  // owns inline cloud bytes
-  UploadForm form;              // owns spool files
-  RegistrationParams params;
-  CloudSource source, target;
   try {
     if (body_kind(exchange.request) == BodyKind::kJson) {
-      from_json(exchange.body.read_all(json_body_limit(service)), request);
-      params = params_from_proto(request.params());
-      source = service.cloud_source(request.source(), "source");
-      target = service.cloud_source(request.target(), "target");
+      from_json(exchange.body.read_all(json_body_limit(service)), call->request);
+      call->params = params_from_proto(call->request.params());
+      call->preview_points = preview_points_from_proto(call->request.preview_points());
+      call->source = service.cloud_source(call->request.source(), "source");
+      call->target = service.cloud_source(call->request.target(), "target");
     } else {
       clock.upload_start = CallClock::Clock::now();
-      form = read_upload_form(exchange.body, service);
+      call->form = read_upload_form(exchange.body, service, FormKind::kPair);
       clock.upload_end = CallClock::Clock::now();
-      params = params_from_proto(form.params);
-      source = form.clouds[0];
-      target = form.clouds[1];
+      call->params = params_from_proto(call->form.params.pairwise());
+      call->preview_points = preview_points_from_proto(call->form.preview_points);
+      call->source = call->form.clouds[0];
+      call->target = call->form.clouds[1];
     }
   } catch (...) {
     exchange.fail(status_from_current_exception());
+    return;
+  }
+  if (wants_events(exchange.request)) {
+    stream_job(service, exchange, clock, [call, &service](Job& job, StreamedCall& events) {
+      const StageListener listener = [&events](const std::string& stage, v1::StageEvent::Phase phase, double fraction) {
+        events.post_stage<v1::RegisterStreamResponse>(stage, phase, fraction);
+      };
+      v1::RegisterStreamResponse reply;
+      const grpc::Status status = run_job(service, job, call->source, call->target, call->params, call->preview_points,
+                                          listener, events.clock, events.record, *reply.mutable_result());
+      if (status.ok()) events.post(reply);
+      return status;
+    });
     return;
   }
   v1::RegisterResponse reply;
   bool queue_full = false;
   const grpc::Status status = run_and_wait(
       service, clock,
-      [&](Job& job) { return run_job(service, job, source, target, params, {}, clock, exchange.record, reply); },
+      [&](Job& job) {
+        return run_job(service, job, call->source, call->target, call->params, call->preview_points, {}, clock,
+                       exchange.record, reply);
+      },
       queue_full);
   if (!status.ok()) {
     exchange.fail(status, queue_full);

@@ -5,6 +5,7 @@
 #include "http_register.h"
 #include "http_register_project.h"
 #include "metrics.h"
+#include "web_page.h"
 
 namespace k4reg::service {
 namespace {
@@ -30,6 +31,12 @@ void handle_readyz(const ServiceContext& service, HttpExchange& exchange) {
 
 void handle_version(const ServiceContext& service, HttpExchange& exchange) { exchange.reply(service.server_info); }
 
+// The QA page (web/): upload scans, watch the job, look at the result. Open like the API description: it is
+// the same for everyone and holds no data; registering through it needs the token where one is set.
+void handle_page(const ServiceContext&, HttpExchange& exchange) {
+  exchange.reply(200, web::render_page(nullptr), "text/html; charset=utf-8");
+}
+
 void handle_openapi(const ServiceContext&, HttpExchange& exchange) {
   exchange.reply(200, std::string(openapi_document()), kJsonContentType);
 }
@@ -52,6 +59,7 @@ constexpr HttpRoute kRoutes[] = {
     {"GET", "/readyz", true, nullptr, handle_readyz},
     {"GET", "/metrics", true, nullptr, handle_metrics},
     {"GET", "/openapi.json", true, nullptr, handle_openapi},
+    {"GET", "/", true, nullptr, handle_page},
 };
 
 }  // namespace

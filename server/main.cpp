@@ -108,8 +108,9 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
     // Before the gRPC port file: whoever waits for that one finds this one written.
     if (!config.http_port_file.empty()) write_port_file(config.http_port_file, http->port());
   }
-  if (!config.port_file.empty()) write_port_file(config.port_file, port);
+  // The log line first: whoever waits for the port file finds the line (with the health port) written.
   log_json(spdlog::level::info, "serving", std::move(serving));
+  if (!config.port_file.empty()) write_port_file(config.port_file, port);
 
   int signal_number = 0;
   sigwait(&stop_signals, &signal_number);

@@ -83,4 +83,13 @@ void project_result_to_proto(const ProjectResult& r, const std::vector<std::stri
   }
 }
 
+void pair_event_to_proto(const ProjectLink& link, std::size_t index, std::size_t pairs, v1::PairEvent& event) {
+  event.set_index(static_cast<std::uint32_t>(index));
+  event.set_pairs(static_cast<std::uint32_t>(pairs));
+  event.set_source(static_cast<std::uint32_t>(link.source));
+  event.set_target(static_cast<std::uint32_t>(link.target));
+  event.set_seconds(link.seconds);
+  if (link.verdict == "failed") event.set_error(link.reason);
+}
+
 }  // namespace k4reg::service

@@ -16,4 +16,7 @@ ProjectParams project_params_from_proto(const v1::ProjectParams& message);
 // files: each scan as the request named it.
 void project_result_to_proto(const ProjectResult& result, const std::vector<std::string>& files, v1::ProjectResult* message);
 
+// The event of the index-th of `pairs` pairs, registered as `link`.
+void pair_event_to_proto(const ProjectLink& link, std::size_t index, std::size_t pairs, v1::PairEvent& event);
+
 }  // namespace k4reg::service

@@ -8,6 +8,7 @@
 
 #include "k4reg/util/error.h"
 #include "project_convert.h"
+#include "proto_convert.h"
 #include "status_mapping.h"
 
 namespace k4reg::service {
@@ -19,9 +20,10 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 
 }  // namespace
 
-ProjectResult run_project(const std::vector<CloudSource>& scans, ProjectParams params, const JobLimits& limits,
-                          MemoryBudget& memory, const CancellationToken& token, const StageListener& stages,
-                          const PairListener& pairs, ProjectReport& report) {
+ProjectOutcome run_project(const std::vector<CloudSource>& scans, const std::vector<std::string>& names,
+                           ProjectParams params, std::size_t preview_points, const JobLimits& limits,
+                           MemoryBudget& memory, const CancellationToken& token, const StageListener& stages,
+                           const PairListener& pairs, ProjectReport& report) {
   token.throw_if_stopped();  // cancelled or expired while queued
   StageTracker progress(stages);
   const auto load_start = Clock::now();
@@ -41,29 +43,38 @@ ProjectResult run_project(const std::vector<CloudSource>& scans, ProjectParams p
   if (params.pairwise.threads == 0 || params.pairwise.threads > limits.job_threads) params.pairwise.threads = limits.job_threads;
   const auto start = Clock::now();
   const ProgressCallback callback = [&](const std::string& stage, double fraction) { progress(stage, fraction); };
-  ProjectResult result = register_project(clouds, params, &token, callback, pairs);
+  ProjectOutcome outcome{register_project(clouds, params, &token, callback, pairs), std::nullopt};
   report.registration_s = seconds_since(start);
-  return result;
+  outcome.preview = preview_stage(preview_points, progress, [&](const PreviewParams& preview) {
+    return make_project_preview(clouds, names, outcome.result, preview, &token);
+  });
+  return outcome;
 }
 
-ProjectJob project_job_from_proto(const ServiceContext& service, const v1::RegisterProjectRequest& request) {
+ProjectJob make_project_job(std::vector<CloudSource> scans, const v1::ProjectParams& params, std::uint32_t preview_points) {
   ProjectJob job;
-  job.params = project_params_from_proto(request.params());
-  if (request.scans_size() < 2)
-    fail(ErrorCode::kInvalidArgument, fmt::format("a project needs at least 2 scans, got {}", request.scans_size()));
+  job.params = project_params_from_proto(params);
+  job.preview_points = preview_points_from_proto(preview_points);
+  if (scans.size() < 2)
+    fail(ErrorCode::kInvalidArgument, fmt::format("a project needs at least 2 scans, got {}", scans.size()));
   std::set<std::string> files;
-  for (int i = 0; i < request.scans_size(); ++i) {
-    const std::string role = fmt::format("scan {}", i);
-    CloudSource scan = service.cloud_source(request.scans(i), role.c_str());
-    if (!scan.file.empty() && !files.insert(scan.file).second)
-      fail(ErrorCode::kInvalidArgument, fmt::format("{} ({}) is given twice: each scan once", role, scan.name));
-    job.names.push_back(scan.name);
-    job.scans.push_back(std::move(scan));
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    if (!scans[i].file.empty() && !files.insert(scans[i].file).second)
+      fail(ErrorCode::kInvalidArgument, fmt::format("scan {} ({}) is given twice: each scan once", i, scans[i].name));
+    job.names.push_back(scans[i].name);
   }
+  job.scans = std::move(scans);
   if (job.params.reference >= job.scans.size())
     fail(ErrorCode::kInvalidArgument, fmt::format("params.reference {} is out of range: the project has {} scans",
                                                   job.params.reference, job.scans.size()));
   return job;
+}
+
+ProjectJob project_job_from_proto(const ServiceContext& service, const v1::RegisterProjectRequest& request) {
+  std::vector<CloudSource> scans;
+  for (int i = 0; i < request.scans_size(); ++i)
+    scans.push_back(service.cloud_source(request.scans(i), fmt::format("scan {}", i).c_str()));
+  return make_project_job(std::move(scans), request.params(), request.preview_points());
 }
 
 grpc::Status run_project_job(const ServiceContext& service, Job& job, const ProjectJob& project, const StageListener& stages,
@@ -73,9 +84,10 @@ grpc::Status run_project_job(const ServiceContext& service, Job& job, const Proj
   ProjectReport report;
   grpc::Status status;
   try {
-    const ProjectResult result =
-        run_project(project.scans, project.params, service.limits, service.memory, job.token(), stages, pairs, report);
-    project_result_to_proto(result, project.names, reply.mutable_result());
+    const ProjectOutcome outcome = run_project(project.scans, project.names, project.params, project.preview_points,
+                                               service.limits, service.memory, job.token(), stages, pairs, report);
+    project_result_to_proto(outcome.result, project.names, reply.mutable_result());
+    if (outcome.preview) preview_to_proto(*outcome.preview, reply.mutable_preview());
   } catch (...) {
     status = status_from_current_exception();
   }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "k4reg/project/project_registration.h"
@@ -20,12 +21,19 @@ struct ProjectReport {
 // Called on the worker thread after each pair.
 using PairListener = std::function<void(const ProjectLink& link, std::size_t index, std::size_t pairs)>;
 
+// What a project job answers: the result and, when asked for (preview_points > 0), the preview.
+struct ProjectOutcome {
+  ProjectResult result;
+  std::optional<CloudPreview> preview;
+};
+
 // Throws k4reg::Error: the first scan that cannot be read (named as the client named it), kInvalidArgument
 // for a malformed project (fewer than 2 scans, a reference out of range, ...), kResourceExhausted over the
-// memory budget, kCancelled / kDeadlineExceeded once the token fires.
-ProjectResult run_project(const std::vector<CloudSource>& scans, ProjectParams params, const JobLimits& limits,
-                          MemoryBudget& memory, const CancellationToken& token, const StageListener& stages,
-                          const PairListener& pairs, ProjectReport& report);
+// memory budget, kCancelled / kDeadlineExceeded once the token fires. The preview is the last stage.
+ProjectOutcome run_project(const std::vector<CloudSource>& scans, const std::vector<std::string>& names,
+                           ProjectParams params, std::size_t preview_points, const JobLimits& limits,
+                           MemoryBudget& memory, const CancellationToken& token, const StageListener& stages,
+                           const PairListener& pairs, ProjectReport& report);
 
 // A project request as the worker will run it: its scans (references resolved, inline bytes owned by the
 // request) and parameters. Throws k4reg::Error for fewer than 2 scans, a scan given twice by path, bad
@@ -34,7 +42,9 @@ struct ProjectJob {
   std::vector<CloudSource> scans;
   std::vector<std::string> names;  // as the request named them
   ProjectParams params;
+  std::size_t preview_points = 0;
 };
+ProjectJob make_project_job(std::vector<CloudSource> scans, const v1::ProjectParams& params, std::uint32_t preview_points);
 ProjectJob project_job_from_proto(const ServiceContext& service, const v1::RegisterProjectRequest& request);
 
 // The worker's side of a project call, the same for gRPC and HTTP (cf. run_job): runs it, times it on

@@ -1,5 +1,6 @@
 #include "project_reactor.h"
 
+#include "project_convert.h"
 #include "status_mapping.h"
 
 namespace k4reg::service {
@@ -27,13 +28,7 @@ void ProjectReactor::execute(Job& job) {
   };
   const PairListener pairs = [this](const ProjectLink& link, std::size_t index, std::size_t count) {
     v1::RegisterProjectEvent message;
-    v1::PairEvent& event = *message.mutable_pair();
-    event.set_index(static_cast<std::uint32_t>(index));
-    event.set_pairs(static_cast<std::uint32_t>(count));
-    event.set_source(static_cast<std::uint32_t>(link.source));
-    event.set_target(static_cast<std::uint32_t>(link.target));
-    event.set_seconds(link.seconds);
-    if (link.verdict == "failed") event.set_error(link.reason);
+    pair_event_to_proto(link, index, count, *message.mutable_pair());
     post(std::move(message));
   };
   v1::RegisterProjectEvent reply;

@@ -1,5 +1,6 @@
 #include "proto_convert.h"
 
+#include <bit>
 #include <string>
 
 #include "k4reg/util/error.h"
@@ -91,6 +92,37 @@ void matrix_to_proto(const Eigen::Matrix4d& matrix, google::protobuf::RepeatedFi
     for (int c = 0; c < 4; ++c) values->Add(matrix(r, c));
 }
 
+void points_to_proto(const std::vector<Eigen::Vector3d>& points, google::protobuf::RepeatedField<double>* values) {
+  values->Clear();
+  for (const Eigen::Vector3d& p : points) values->Add(p.data(), p.data() + 3);
+}
+
+std::size_t preview_points_from_proto(std::uint32_t points) {
+  if (points > kMaxPreviewPoints)
+    fail(ErrorCode::kInvalidArgument,
+         "preview_points must be at most " + std::to_string(kMaxPreviewPoints) + " (0 = no preview)");
+  return points;
+}
+
+void preview_to_proto(const CloudPreview& preview, v1::Preview* m) {
+  m->clear_offset_m();
+  m->mutable_offset_m()->Add(preview.offset_m.data(), preview.offset_m.data() + 3);
+  m->set_distance_cap_m(preview.distance_cap_m);
+  m->clear_clouds();
+  static_assert(std::endian::native == std::endian::little, "the API's previews are little-endian float32");
+  auto bytes = [](const auto& values) {
+    return std::string(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(values[0]));
+  };
+  for (const PreviewCloud& cloud : preview.clouds) {
+    v1::PreviewCloud* out = m->add_clouds();
+    out->set_name(cloud.name);
+    out->set_points(cloud.points);
+    out->set_xyz(bytes(cloud.xyz));
+    out->set_distance_m(bytes(cloud.distance_m));
+    out->set_keypoints_xyz(bytes(cloud.keypoints));
+  }
+}
+
 void result_to_proto(const RegistrationResult& r, v1::RegistrationResult* m) {
   matrix_to_proto(r.transform, m->mutable_transform());
   m->set_rmse_m(r.rmse_m);
@@ -116,6 +148,8 @@ void result_to_proto(const RegistrationResult& r, v1::RegistrationResult* m) {
     out->set_cloud_score(h.cloud_score);
     out->set_refined_score(h.refined_score);
     out->set_surface_agreement(h.surface_agreement);
+    points_to_proto(h.base_source_m, out->mutable_base_source_m());
+    points_to_proto(h.base_target_m, out->mutable_base_target_m());
   }
   m->set_bases_tried(r.bases_tried);
   m->set_seed(r.seed);

@@ -1,6 +1,7 @@
 // k4reg.v1 messages <-> core structs. Shared by the gRPC service and the HTTP/JSON API.
 #pragma once
 
+#include "k4reg/qa/cloud_preview.h"
 #include "k4reg/registration/registration.h"
 #include "k4reg/v1/registration.pb.h"
 
@@ -11,6 +12,13 @@ namespace k4reg::service {
 RegistrationParams params_from_proto(const v1::RegistrationParams& message);
 
 void result_to_proto(const RegistrationResult& result, v1::RegistrationResult* message);
+
+// Points -> x, y, z of each in turn.
+void points_to_proto(const std::vector<Eigen::Vector3d>& points, google::protobuf::RepeatedField<double>* values);
+
+// A request's preview_points; throws k4reg::Error(kInvalidArgument) over kMaxPreviewPoints.
+std::size_t preview_points_from_proto(std::uint32_t points);
+void preview_to_proto(const CloudPreview& preview, v1::Preview* message);
 
 // Row-major 4x4 -> 16 repeated doubles.
 void matrix_to_proto(const Eigen::Matrix4d& matrix, google::protobuf::RepeatedField<double>* values);

@@ -15,6 +15,7 @@ RegisterReactor::RegisterReactor(ServiceContext& service, grpc::CallbackServerCo
   }
   try {
     params_ = params_from_proto(request->params());
+    preview_points_ = preview_points_from_proto(request->preview_points());
     source_ = service_.cloud_source(request->source(), "source");
     target_ = service_.cloud_source(request->target(), "target");
   } catch (...) {
@@ -30,7 +31,7 @@ RegisterReactor::RegisterReactor(ServiceContext& service, grpc::CallbackServerCo
 }
 
 void RegisterReactor::execute(Job& job) {
-  finish(run_job(service_, job, source_, target_, params_, {}, clock_, record_, *reply_));
+  finish(run_job(service_, job, source_, target_, params_, preview_points_, {}, clock_, record_, *reply_));
 }
 
 void RegisterReactor::OnCancel() {

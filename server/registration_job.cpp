@@ -42,9 +42,20 @@ void StageTracker::operator()(const std::string& stage, double fraction) {
             std::clamp(fraction, 0.0, 1.0));
 }
 
-RegistrationResult run_registration(const CloudSource& source, const CloudSource& target, RegistrationParams params,
-                                    const JobLimits& limits, MemoryBudget& memory, const CancellationToken& token,
-                                    const StageListener& listener, JobReport& report) {
+std::optional<CloudPreview> preview_stage(std::size_t preview_points, StageTracker& progress,
+                                          const std::function<CloudPreview(const PreviewParams&)>& make) {
+  if (preview_points == 0) return std::nullopt;
+  progress("preview", 0.0);
+  PreviewParams params;
+  params.max_points = preview_points;
+  CloudPreview preview = make(params);
+  progress("preview", 1.0);
+  return preview;
+}
+
+RegistrationOutcome run_registration(const CloudSource& source, const CloudSource& target, RegistrationParams params,
+                                     std::size_t preview_points, const JobLimits& limits, MemoryBudget& memory,
+                                     const CancellationToken& token, const StageListener& listener, JobReport& report) {
   token.throw_if_stopped();  // cancelled or expired while queued
   StageTracker progress(listener);
 
@@ -65,9 +76,12 @@ RegistrationResult run_registration(const CloudSource& source, const CloudSource
   if (params.threads == 0 || params.threads > limits.job_threads) params.threads = limits.job_threads;
   const auto start = Clock::now();
   const ProgressCallback callback = [&](const std::string& stage, double fraction) { progress(stage, fraction); };
-  RegistrationResult result = register_clouds(source_cloud, target_cloud, params, &token, callback);
+  RegistrationOutcome outcome{register_clouds(source_cloud, target_cloud, params, &token, callback), std::nullopt};
   report.registration_s = seconds_since(start);
-  return result;
+  outcome.preview = preview_stage(preview_points, progress, [&](const PreviewParams& preview) {
+    return make_pair_preview(source_cloud, target_cloud, outcome.result, preview, &token);
+  });
+  return outcome;
 }
 
 }  // namespace k4reg::service

@@ -4,10 +4,12 @@
 
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 
 #include "k4reg/io/cloud_io.h"
+#include "k4reg/qa/cloud_preview.h"
 #include "k4reg/util/cancellation.h"
 #include "k4reg/registration/registration.h"
 #include "k4reg/v1/registration.pb.h"
@@ -49,12 +51,23 @@ class StageTracker {
   bool finished_ = false;
 };
 
+// The preview as a job's last stage ("preview"): `make` with preview_points, or none when that is 0.
+std::optional<CloudPreview> preview_stage(std::size_t preview_points, StageTracker& progress,
+                                          const std::function<CloudPreview(const PreviewParams&)>& make);
+
 // Reads a cloud; error messages name it as the client did (never a server path). Throws k4reg::Error.
 PointCloud load_cloud(const CloudSource& source, const ReadOptions& options);
 
-// Throws k4reg::Error (kCancelled / kDeadlineExceeded once the token fires).
-RegistrationResult run_registration(const CloudSource& source, const CloudSource& target, RegistrationParams params,
-                                    const JobLimits& limits, MemoryBudget& memory, const CancellationToken& token,
-                                    const StageListener& listener, JobReport& report);
+// What a pair job answers: the result and, when asked for (preview_points > 0), the preview.
+struct RegistrationOutcome {
+  RegistrationResult result;
+  std::optional<CloudPreview> preview;
+};
+
+// Throws k4reg::Error (kCancelled / kDeadlineExceeded once the token fires). The preview is the last stage
+// ("preview").
+RegistrationOutcome run_registration(const CloudSource& source, const CloudSource& target, RegistrationParams params,
+                                     std::size_t preview_points, const JobLimits& limits, MemoryBudget& memory,
+                                     const CancellationToken& token, const StageListener& listener, JobReport& report);
 
 }  // namespace k4reg::service

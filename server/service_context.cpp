@@ -104,15 +104,16 @@ void decorate_reply(const ServiceContext& service, const CallClock& clock, const
 }
 
 grpc::Status run_job(const ServiceContext& service, Job& job, const CloudSource& source, const CloudSource& target,
-                     const RegistrationParams& params, const StageListener& listener, CallClock& clock,
-                     RequestRecord& record, v1::RegisterResponse& reply) {
+                     const RegistrationParams& params, std::size_t preview_points, const StageListener& listener,
+                     CallClock& clock, RequestRecord& record, v1::RegisterResponse& reply) {
   clock.job_start = CallClock::Clock::now();
   JobReport report;
   grpc::Status status;
   try {
-    const RegistrationResult result =
-        run_registration(source, target, params, service.limits, service.memory, job.token(), listener, report);
-    result_to_proto(result, reply.mutable_result());
+    const RegistrationOutcome outcome = run_registration(source, target, params, preview_points, service.limits,
+                                                         service.memory, job.token(), listener, report);
+    result_to_proto(outcome.result, reply.mutable_result());
+    if (outcome.preview) preview_to_proto(*outcome.preview, reply.mutable_preview());
   } catch (...) {
     status = status_from_current_exception();
   }

@@ -51,6 +51,7 @@ void StreamReactor::OnReadDone(bool ok) {
 void StreamReactor::on_header(const v1::UploadHeader& header) {
   clock_.upload_start = CallClock::Clock::now();
   params_ = params_from_proto(header.params());
+  preview_points_ = preview_points_from_proto(header.preview_points());
   source_ = prepare(header.source(), "source", uploads_[0]);
   target_ = prepare(header.target(), "target", uploads_[1]);
 }
@@ -125,7 +126,8 @@ void StreamReactor::execute(Job& job) {
   };
   v1::RegisterStreamResponse reply;
   const grpc::Status status =
-      run_job(service_, job, source_, target_, params_, listener, clock_, record_, *reply.mutable_result());
+      run_job(service_, job, source_, target_, params_, preview_points_, listener, clock_, record_,
+              *reply.mutable_result());
   if (status.ok()) post(std::move(reply));
   finish(status);
 }

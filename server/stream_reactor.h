@@ -49,6 +49,7 @@ class StreamReactor final
   v1::RegisterStreamRequest request_;
   bool header_seen_ = false;
   RegistrationParams params_;
+  std::size_t preview_points_ = 0;
   CloudSource source_, target_;
   std::array<Upload, 2> uploads_;  // source, target
 };

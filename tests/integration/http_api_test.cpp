@@ -164,10 +164,12 @@ TEST_F(HttpApi, OpenApiSchemasMatchTheProtoMessages) {
   }
   // Every message of the API's JSON bodies.
   EXPECT_EQ(checked, (std::set<std::string>{"CloudInput", "HealthCheckResponse", "Hypothesis", "InlineCloud",
-                                            "ProjectLink", "ProjectParams", "ProjectResult", "ProjectScan",
+                                            "PairEvent", "Preview", "PreviewCloud", "ProjectLink", "ProjectParams",
+                                            "ProjectResult", "ProjectScan", "QueuedEvent", "RegisterProjectEvent",
                                             "RegisterProjectRequest", "RegisterProjectResponse", "RegisterRequest",
-                                            "RegisterResponse", "RegistrationParams", "RegistrationResult", "ScanPair",
-                                            "ServerInfo", "ServerTimings", "StageTiming"}));
+                                            "RegisterResponse", "RegisterStreamResponse", "RegistrationParams",
+                                            "RegistrationResult", "ScanPair", "ServerInfo", "ServerTimings",
+                                            "StageEvent", "StageTiming"}));
 }
 
 TEST_F(HttpApi, JsonRegistrationIsIdenticalToGrpc) {

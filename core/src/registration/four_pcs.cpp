@@ -73,6 +73,7 @@ bool passes_prescreens(const Verifier& verifier, const Eigen::Matrix4d& t, doubl
 struct Candidate {
   double score = 0;
   Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();
+  Eigen::Matrix<float, 3, 4> base, set;  // the base's points and the congruent set's, kept for the QA report
 };
 
 // The best few distinct candidates of one base. A base of a symmetric scene matches both the true
@@ -176,7 +177,8 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
           if (!passes_prescreens(verifier, t, 0.5 * beat)) continue;
           const double full = verifier.score(t, verifier.size(), std::max(out.floor(), 0.5 * global_best));
           if (full > out.floor() && full > 0)
-            out.offer({full, t}, kDistinctAngle_deg, kDistinctShiftDeltas * params.delta_m);
+            out.offer({full, t, from.cast<float>(), to.cast<float>()}, kDistinctAngle_deg,
+                      kDistinctShiftDeltas * params.delta_m);
         }
       });
       for (int b = start; b < end; ++b)
@@ -209,6 +211,10 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
     Hypothesis h;
     h.transform = c.transform;
     h.keypoint_score = c.score / verifier.size();
+    for (int k = 0; k < 4; ++k) {
+      h.base_source_m.push_back(c.base.col(k).cast<double>());
+      h.base_target_m.push_back(c.set.col(k).cast<double>());
+    }
     result.hypotheses.push_back(h);
   }
   if (result.hypotheses.empty())

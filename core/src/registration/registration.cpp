@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <optional>
 
@@ -131,6 +132,8 @@ double spacing_for_count(const PointCloud& voxels, double start_m, std::size_t p
 struct CoarseAlignment {
   std::string signal;
   std::size_t source_keypoints = 0, target_keypoints = 0;
+  const std::vector<Eigen::Vector3f>* source_points = nullptr;  // what 4PCS matched (local frames)
+  const std::vector<Eigen::Vector3f>* target_points = nullptr;
   int bases_tried = 0;
   double overlap = 0.0;  // whose bases found it
   SymmetryGuardResult guarded;
@@ -228,7 +231,7 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
   const ScanViews views{free_space ? &*free_space : nullptr, scanner_position(source), scanner_position(target)};
 
   // 2. The point sets 4PCS runs on: DoG keypoints (K-4PCS) or a coarser voxel grid (plain 4PCS).
-  std::vector<PointSets> point_sets;  // one per signal asked for so far
+  std::deque<PointSets> point_sets;  // one per signal asked for so far (a deque: CoarseAlignment points into it)
   auto sets_for = [&](KeypointSignal signal) -> const PointSets& {
     const bool intensity = source.has_intensity() && target.has_intensity();
     for (const PointSets& sets : point_sets)
@@ -271,6 +274,8 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
     out.signal = sets.signal;
     out.source_keypoints = sets.source.size();
     out.target_keypoints = sets.target.size();
+    out.source_points = &sets.source;
+    out.target_points = &sets.target;
     out.overlap = overlap;
 
     // 3. 4PCS on the two point sets (paper Sec. 2.2).
@@ -419,7 +424,18 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
   }
 
   result.transform = to_file_frames(local, source.origin_m, target.origin_m);
-  for (Hypothesis& h : result.hypotheses) h.transform = to_file_frames(h.transform, source.origin_m, target.origin_m);
+  auto in_file_frame = [](std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& origin) {
+    for (Eigen::Vector3d& p : points) p += origin;
+  };
+  for (Hypothesis& h : result.hypotheses) {
+    h.transform = to_file_frames(h.transform, source.origin_m, target.origin_m);
+    in_file_frame(h.base_source_m, source.origin_m);
+    in_file_frame(h.base_target_m, target.origin_m);
+  }
+  for (const Eigen::Vector3f& p : *chosen->source_points)
+    result.source_keypoint_positions_m.push_back(p.cast<double>() + source.origin_m);
+  for (const Eigen::Vector3f& p : *chosen->target_points)
+    result.target_keypoint_positions_m.push_back(p.cast<double>() + target.origin_m);
   result.well_supported = on_the_surface && best.refined_score >= needed;
   const bool supported = result.well_supported;
   return {std::move(result), supported};

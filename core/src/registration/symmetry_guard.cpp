@@ -207,14 +207,19 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
     const Eigen::Vector3d centre = trimmed_centre(coarse_target.points).cast<double>();
     const Eigen::Matrix4d& best = hypotheses.front().transform;
     std::vector<Hypothesis> twins;
+    auto twin = [](const Eigen::Matrix4d& transform) {
+      Hypothesis h;
+      h.transform = transform;
+      return h;
+    };
     for (const Eigen::Matrix4d& s : half_turns(point_axes(coarse_target.points, centre), centre))
-      twins.push_back({s * best, 0.0, 0.0});
+      twins.push_back(twin(s * best));
     for (const Eigen::Matrix4d& s : half_turns(normal_axes(coarse_target.normals), centre)) {
       Eigen::Matrix4d turned = s * best;
       for (const Eigen::Vector3d& shift : vote_translations(voting_source, voting_target, turned.topLeftCorner<3, 3>(),
                                                             2.0 * coarse_target.voxel_m, kShifts)) {
         turned.topRightCorner<3, 1>() = shift;
-        twins.push_back({turned, 0.0, 0.0});
+        twins.push_back(twin(turned));
       }
     }
     settle_all(twins);

@@ -75,6 +75,9 @@ struct Hypothesis {
   // (pose_score.h). A true pose puts them on it; a wrong one only touches it.
   double refined_score = 0.0;
   double surface_agreement = 0.0;
+  // The 4-point base it came from (source file frame) and the congruent set 4PCS matched it to (target file
+  // frame), for looking at (the QA report); empty for the symmetric twins the symmetry guard adds.
+  std::vector<Eigen::Vector3d> base_source_m, base_target_m;
 };
 
 // A refined pose with less surface agreement than this is not taken as well supported.
@@ -111,6 +114,9 @@ struct RegistrationResult {
   // supported is not).
   bool well_supported = false;
   std::vector<Hypothesis> hypotheses;  // best first
+  // The points 4PCS matched (DoG keypoints, or the coarse grid of plain 4PCS) at the scale used, each in its
+  // file's frame: for looking at (the QA report), a few thousand each.
+  std::vector<Eigen::Vector3d> source_keypoint_positions_m, target_keypoint_positions_m;
   int bases_tried = 0;
   std::uint64_t seed = 0;
   bool icp_converged = false;
