@@ -131,6 +131,57 @@ TEST_F(ClientCommands, RegisterByReferencePrintsTheTable) {
   EXPECT_EQ(run.err.find("uploaded"), std::string::npos);  // nothing to upload
 }
 
+// The document a --report page carries (web/report_document.h).
+nlohmann::json report_document(const fs::path& page_file) {
+  const std::string page = read_file(page_file);
+  const std::string open = "<script id=\"k4reg-document\" type=\"application/json\">";
+  const std::size_t begin = page.find(open);
+  if (begin == std::string::npos) return nullptr;
+  std::string json = page.substr(begin + open.size(), page.find("</script>", begin) - begin - open.size());
+  for (std::size_t at = json.find("<\\/"); at != std::string::npos; at = json.find("<\\/", at)) json.erase(at + 1, 1);
+  return nlohmann::json::parse(json);
+}
+
+TEST_F(ClientCommands, RegisterWritesAlignsReportWithTheServersPreview) {
+  TempDir work;
+  const CommandRun local = k4reg(concat({"align", bunny("bun045.ply"), bunny("bun000.ply"), "--report",
+                                         (work.path() / "local.html").string(), "--report-points", "4000"},
+                                        kBunnyFlags));
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  const CommandRun remote =
+      k4reg(concat({"register", "bun045.ply", "bun000.ply", "--ref", "--server", server_->address(), "--report",
+                    (work.path() / "remote.html").string(), "--report-points", "4000"},
+                   kBunnyFlags));
+  ASSERT_EQ(remote.exit_code, 0) << remote.err;
+  const nlohmann::json a = report_document(work.path() / "local.html"), b = report_document(work.path() / "remote.html");
+  ASSERT_TRUE(a.is_object() && b.is_object());
+  EXPECT_EQ(a["kind"], "pair");
+  EXPECT_EQ(b["generator"], "k4reg register");
+  EXPECT_EQ(a["result"]["transform"], b["result"]["transform"]);
+  EXPECT_EQ(a["result"]["hypotheses"][0]["base_source_m"], b["result"]["hypotheses"][0]["base_source_m"]);
+  EXPECT_EQ(a["result"]["hypotheses"][0]["base_source_m"].size(), 12u);
+  // The server's preview is the local one, byte for byte (the same subsample of the same clouds).
+  ASSERT_EQ(b["preview"]["clouds"].size(), 2u);
+  EXPECT_EQ(a["preview"], b["preview"]);
+  EXPECT_EQ(b["result"]["request_id"].get<std::string>().size(), 36u);
+
+  const CommandRun project = k4reg({"register-project", "bun000.ply", "bun045.ply", "bun090.ply", "--ref", "--server",
+                                    server_->address(), "--min-scale", "0.002", "--overlap", "0.5", "--report",
+                                    (work.path() / "project.html").string(), "--report-points", "3000"});
+  ASSERT_EQ(project.exit_code, 0) << project.err;
+  const nlohmann::json c = report_document(work.path() / "project.html");
+  EXPECT_EQ(c["kind"], "project");
+  EXPECT_EQ(c["result"]["scans"].size(), 3u);
+  EXPECT_EQ(c["preview"]["clouds"].size(), 3u);
+  EXPECT_EQ(c["files"][1], "bun045.ply");
+  // A report that cannot be written fails the command, and says where.
+  const CommandRun unwritable = k4reg(concat({"align", bunny("bun045.ply"), bunny("bun000.ply"), "--report",
+                                              "/nonexistent-folder/r.html"},
+                                             kQuickFlags));
+  EXPECT_EQ(unwritable.exit_code, 1);
+  EXPECT_NE(unwritable.err.find("/nonexistent-folder/r.html"), std::string::npos) << unwritable.err;
+}
+
 TEST_F(ClientCommands, ProgressFlagDrawsTheBarWithoutATerminal) {
   const CommandRun run = k4reg(concat(
       {"register", bunny("bun045.ply"), bunny("bun000.ply"), "--server", server_->address(), "--progress", "--json"},
