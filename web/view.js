@@ -36,7 +36,6 @@
       var v = attrs[k];
       if (v === undefined || v === null || v === false) return;
       if (k === 'text') e.textContent = v;
-      else if (k === 'html') e.innerHTML = v;
       else if (k.slice(0, 2) === 'on' && typeof v === 'function') e.addEventListener(k.slice(2), v);
       else if (k === 'class') e.setAttribute('class', v);
       else if (k === 'style' && typeof v === 'object') Object.assign(e.style, v);

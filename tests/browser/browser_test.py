@@ -48,6 +48,9 @@ def start_browser(work):
         options.add_argument(flag)
     options.add_argument("--user-data-dir=" + tempfile.mkdtemp(prefix="chromium-", dir=work))
     options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    options.add_experimental_option("prefs", {"download.default_directory": os.path.join(work, "downloads"),
+                                              "download.prompt_for_download": False,
+                                              "profile.default_content_setting_values.automatic_downloads": 1})
     driver = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
     driver.set_script_timeout(60)
     return driver
@@ -192,6 +195,27 @@ def start_server(binary, work):
     return process, int(open(port_file).read())
 
 
+def download(driver, work, button, name):
+    """Clicks a download button; the downloaded file's path once it is complete."""
+    path = os.path.join(work, "downloads", name)
+    driver.find_element("id", button).click()
+    deadline = time.monotonic() + 30
+    while not os.path.exists(path) or os.path.exists(path + ".crdownload"):
+        if time.monotonic() > deadline:
+            raise AssertionError(f"{name} was not downloaded")
+        time.sleep(0.1)
+    time.sleep(0.2)  # the rename has happened; let the writer close it
+    return path
+
+
+def fill_parameters(driver):
+    """The page's parameter fields as the CLI runs used them (PARAMS)."""
+    for field, value in (("min-scale", "0.002"), ("seed", "1")):
+        element = driver.find_element("id", field)
+        element.clear()
+        element.send_keys(value)
+
+
 def submit_and_wait(driver, what):
     driver.find_element("id", "submit").click()
     wait_for(driver, "return !!(window.k4regView && window.k4regView.ready && window.k4regView.document)", 180,
@@ -206,10 +230,7 @@ def check_page(driver, server, data, work, pair_result, project_result, shots):
         wait_for(driver, "return !!document.getElementById('submit')", 20, "the page")
         driver.find_element("id", "source-file").send_keys(os.path.join(data, PAIR[0]))
         driver.find_element("id", "target-file").send_keys(os.path.join(data, PAIR[1]))
-        driver.find_element("id", "min-scale").send_keys("0.002")
-        seed = driver.find_element("id", "seed")
-        seed.clear()
-        seed.send_keys("1")
+        fill_parameters(driver)
         submit_and_wait(driver, "a pair upload")
         shown = numbers(text(driver, "transform"))
         check(close(shown, pair_result["transform"]), "page: the uploaded pair gets the CLI's transform")
@@ -218,12 +239,23 @@ def check_page(driver, server, data, work, pair_result, project_result, shots):
         check(lit_pixels(driver) > 1000, "page: the 3D view is not blank")
         if shots:
             driver.save_screenshot(os.path.join(shots, "page-pair.png"))
+        transform = numbers(open(download(driver, work, "download-transform", "transform.txt")).read())
+        check(close(transform, pair_result["transform"]), "page: the downloaded transform is the CLI's")
+        report = download(driver, work, "download-report", "report.html")
+        check_self_contained(report)
+        page_url = driver.current_url
+        open_report(driver, report)
+        check(text(driver, "rmse") == js_precision(pair_result["rmse_m"]) and lit_pixels(driver) > 1000,
+              "page: the downloaded report opens offline with the CLI's RMSE and a non-blank view")
+        problems = console_problems(driver)
+        check(not problems, f"downloaded report: no console errors or warnings {problems[:3]}")
+        driver.get(page_url)
+        wait_for(driver, "return !!document.getElementById('submit')", 20, "the page again")
 
         # A project: one multiple-file input, in the CLI's scan order.
         driver.execute_script("window.k4regView = null")
-        mode = driver.find_elements("css selector", "input[name=mode][value=project], #mode-project")
-        if mode:
-            mode[0].click()
+        driver.find_element("id", "mode-project").click()
+        fill_parameters(driver)
         driver.find_element("id", "scan-files").send_keys("\n".join(os.path.join(data, s) for s in PROJECT))
         submit_and_wait(driver, "a project upload")
         poses = driver.find_elements("css selector", "#poses pre.pose")
