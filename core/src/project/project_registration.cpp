@@ -108,9 +108,48 @@ void reject(ProjectResult& r, std::size_t l, const std::string& reason) {
 
 double link_tolerance_m(const ProjectLink& link) { return std::max(2.0 * link.min_scale_m_used, link.rmse_m); }
 
+namespace {
+
+// A pair's link as registered (before selection) and its candidates for the loops: the pairwise winner first.
+LinkCandidates link_from_outcome(const PairOutcome& outcome, const ScanPair& pair, ProjectLink& link) {
+  const auto [s, t] = pair;
+  link.source = s;
+  link.target = t;
+  link.seconds = outcome.seconds;
+  LinkCandidates c{s, t, {}, 0.0, false, 0.0, false};
+  if (!outcome.result) {
+    link.verdict = "failed";
+    link.reason = outcome.error ? outcome.error->what() : "not registered";
+    return c;
+  }
+  const RegistrationResult& result = *outcome.result;
+  link.rmse_m = result.rmse_m;
+  link.overlap = result.overlap;
+  link.cloud_score = result.hypotheses.front().refined_score > 0 ? result.hypotheses.front().refined_score
+                                                                 : result.hypotheses.front().cloud_score;
+  link.ambiguity_margin = result.ambiguity_margin;
+  link.ambiguous = result.ambiguous;
+  link.well_supported = result.well_supported;
+  link.min_scale_m_used = result.min_scale_m_used;
+  link.overlap_used = result.overlap_used;
+  c.transforms.push_back(result.transform);
+  // Runner-ups the free space contradicts outright (a score of 0 or less) cannot be the truth.
+  for (std::size_t h = 1; h < result.hypotheses.size(); ++h)
+    if (result.hypotheses[h].cloud_score > 0) c.transforms.push_back(result.hypotheses[h].transform);
+  link.hypotheses = c.transforms.size();
+  link.transform = result.transform;
+  c.tolerance_m = link_tolerance_m(link);
+  c.ambiguous = result.ambiguous;
+  c.margin = result.ambiguity_margin;
+  c.well_supported = result.well_supported;
+  return c;
+}
+
+}  // namespace
+
 ProjectResult register_project(const std::vector<PointCloud>& scans, const ProjectParams& params,
                                const CancellationToken* cancel, const ProgressCallback& progress,
-                               const PairCallback& on_pair) {
+                               const PairCallback& on_pair, PairRunner* runner) {
   validate(params.pairwise);
   if (scans.size() < 2)
     fail(ErrorCode::kInvalidArgument, fmt::format("a project needs at least 2 scans, got {}", scans.size()));
@@ -135,48 +174,24 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
 
   // 1. Pairwise registration, keeping every distinct hypothesis as a candidate for the loops.
   const std::vector<ScanPair> pairs = candidate_pairs(scans.size(), params.pairs, params.pair_list);
+  std::vector<PairOutcome> outcomes(pairs.size());
+  std::size_t pairs_done = 0;
+  LocalPairRunner local;
+  (runner ? *runner : local).run(scans, pairs, pairwise, &budget, [&](std::size_t k, PairOutcome outcome) {
+    outcomes.at(k) = std::move(outcome);
+    ProjectLink link;
+    link_from_outcome(outcomes[k], pairs[k], link);
+    if (on_pair) on_pair(link, pairs_done, pairs.size());
+    ++pairs_done;
+    if (progress) progress("pairs", static_cast<double>(pairs_done) / pairs.size());
+  });
+  // In the pairs' order, wherever and in whatever order they ran.
   std::vector<LinkCandidates> candidates;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
-    const auto [s, t] = pairs[k];
-    ProjectLink link;
-    link.source = s;
-    link.target = t;
-    LinkCandidates c{s, t, {}, 0.0, false, 0.0, false};
-    const auto start = Clock::now();
-    try {
-      const RegistrationResult pair = register_clouds(scans[s], scans[t], pairwise, &budget, [&](const std::string&, double) {
-        if (progress) progress("pairs", static_cast<double>(k) / pairs.size());
-      });
-      link.rmse_m = pair.rmse_m;
-      link.overlap = pair.overlap;
-      link.cloud_score = pair.hypotheses.front().refined_score > 0 ? pair.hypotheses.front().refined_score
-                                                                    : pair.hypotheses.front().cloud_score;
-      link.ambiguity_margin = pair.ambiguity_margin;
-      link.ambiguous = pair.ambiguous;
-      link.well_supported = pair.well_supported;
-      link.min_scale_m_used = pair.min_scale_m_used;
-      link.overlap_used = pair.overlap_used;
-      c.transforms.push_back(pair.transform);
-      // Runner-ups the free space contradicts outright (a score of 0 or less) cannot be the truth.
-      for (std::size_t h = 1; h < pair.hypotheses.size(); ++h)
-        if (pair.hypotheses[h].cloud_score > 0) c.transforms.push_back(pair.hypotheses[h].transform);
-      link.hypotheses = c.transforms.size();
-      link.transform = pair.transform;
-      c.tolerance_m = link_tolerance_m(link);
-      c.ambiguous = pair.ambiguous;
-      c.margin = pair.ambiguity_margin;
-      c.well_supported = pair.well_supported;
-      for (const StageTiming& t : pair.timings) add_timing(r.timings, t.stage, t.seconds);
-    } catch (const Error& e) {
-      if (e.code() == ErrorCode::kCancelled || e.code() == ErrorCode::kDeadlineExceeded) throw;
-      link.verdict = "failed";
-      link.reason = e.what();
-    }
-    link.seconds = seconds_since(start);
-    if (on_pair) on_pair(link, k, pairs.size());
-    if (progress) progress("pairs", static_cast<double>(k + 1) / pairs.size());
-    r.links.push_back(std::move(link));
-    candidates.push_back(std::move(c));
+    ProjectLink& link = r.links.emplace_back();
+    candidates.push_back(link_from_outcome(outcomes[k], pairs[k], link));
+    if (outcomes[k].result)
+      for (const StageTiming& t : outcomes[k].result->timings) add_timing(r.timings, t.stage, t.seconds);
   }
 
   // 2. One candidate per link, so that the loops close.

@@ -5,7 +5,8 @@
 //   ->  global refinement (pose_graph.h), where a link that disagrees with the refined project is dropped
 //   and the rest solved again.
 // A scan that no majority of accepted links places, or that they hold too weakly to tell it from a
-// symmetric twin, is reported as not registered, never forced into place. Pairs run one after the other, each on all threads, so the result is the same at any thread count.
+// symmetric twin, is reported as not registered, never forced into place. Pairs run one after the other, each on all
+// threads (or wherever a PairRunner sends them), so the result is the same at any thread count and on any runner.
 // Cost: one pairwise registration per candidate pair (0.2-3 s each at 1 M points on 2 cores); selection and
 // refinement take milliseconds.
 #pragma once
@@ -18,6 +19,7 @@
 
 #include "k4reg/geometry/point_cloud.h"
 #include "k4reg/project/candidate_pairs.h"
+#include "k4reg/project/pair_runner.h"
 #include "k4reg/registration/registration.h"
 #include "k4reg/util/cancellation.h"
 
@@ -75,14 +77,17 @@ struct ProjectResult {
 // the scale it was found at.
 double link_tolerance_m(const ProjectLink& link);
 
-// Called after each pair: the link as registered (before selection), its index and the number of pairs.
+// Called after each pair: the link as registered (before selection), how many pairs finished before it and the
+// number of pairs.
 using PairCallback = std::function<void(const ProjectLink& link, std::size_t index, std::size_t pairs)>;
 
 // Throws kInvalidArgument for fewer than 2 scans, an empty scan, a reference out of range or bad pairwise
 // parameters; kCancelled / kDeadlineExceeded when stopped (time_budget_s of the pairwise parameters bounds
 // the whole project). A pair that cannot be registered is a failed link, not an error.
+// `runner` registers the pairs (pair_runner.h); null = one after the other in this process. The poses do not
+// depend on it.
 ProjectResult register_project(const std::vector<PointCloud>& scans, const ProjectParams& params,
                                const CancellationToken* cancel = nullptr, const ProgressCallback& progress = {},
-                               const PairCallback& on_pair = {});
+                               const PairCallback& on_pair = {}, PairRunner* runner = nullptr);
 
 }  // namespace k4reg
