@@ -11,8 +11,8 @@ IMAGE_PACKAGES=(
   libeigen3-dev libtbb-dev libpugixml-dev
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc grpc-proto
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libcpp-httplib-dev libssl-dev
-  libgtest-dev libgmock-dev
   libjs-three  # three.js r111, compiled into the QA report and the server's page (web/)
+  libgtest-dev libgmock-dev
 )
 PACKAGES=(
   "${IMAGE_PACKAGES[@]}" git ca-certificates
