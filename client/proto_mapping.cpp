@@ -75,7 +75,7 @@ std::vector<T> floats_from_bytes(const std::string& bytes, const char* what) {
   if (bytes.size() % sizeof(T) != 0)
     throw CommandError(fmt::format("the server's preview has {} bytes of {}, not whole values", bytes.size(), what));
   std::vector<T> values(bytes.size() / sizeof(T));
-  std::memcpy(static_cast<void*>(values.data()), bytes.data(), bytes.size());
+  if (!values.empty()) std::memcpy(static_cast<void*>(values.data()), bytes.data(), bytes.size());
   return values;
 }
 
