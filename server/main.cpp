@@ -32,6 +32,8 @@ using Clock = std::chrono::steady_clock;
 int milliseconds(double seconds) { return static_cast<int>(std::min(seconds * 1000.0, 2.0e9)); }
 
 void set_connection_options(grpc::ServerBuilder& builder, const ServerConfig& config) {
+  // A peer's pair (RegisterPair) carries two clouds of up to --max-points at 16 bytes per point, within gRPC's 2 GiB.
+  // TODO(issue 23): enforce --max-inline-mb on Register/RegisterProject themselves once this limit is raised.
   builder.SetMaxReceiveMessageSize(static_cast<int>((config.max_inline_mb << 20) + (64 << 10)));
   builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, milliseconds(config.keepalive_time_s));
   builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, 20'000);
@@ -59,11 +61,13 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
   SpoolDir spool(config.spool_dir);
   MemoryBudget memory(config.memory_budget_mb << 20);
   JobQueue queue(config.workers, config.queue_size);
+  JobQueue pair_queue(config.pair_workers, config.pair_queue_size);
   v1::ServerInfo info;
   info.set_version(K4REG_VERSION);
   info.set_server_id(config.server_id);
   Metrics metrics(K4REG_VERSION);
-  const ServiceContext context{queue,
+  ServiceContext context{queue,
+                               pair_queue,
                                memory,
                                paths,
                                spool,
@@ -73,6 +77,16 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
                                std::uint64_t(config.max_inline_mb) << 20,
                                info,
                                metrics};
+  if (!config.peers.empty()) {
+    grpc::ChannelArguments arguments;
+    arguments.SetLoadBalancingPolicyName("round_robin");
+    arguments.SetMaxSendMessageSize(-1);
+    // Peers speak the same TLS as this replica; a client certificate, where required, is not sent yet.
+    context.peers = grpc::CreateCustomChannel(
+        config.peers, tls ? grpc::SslCredentials(grpc::SslCredentialsOptions{}) : grpc::InsecureChannelCredentials(),
+        arguments);
+    context.peer_in_flight = config.peer_in_flight;
+  }
   RegistrationService service(context);
   std::unique_ptr<HttpServer> http;
   if (!config.http_listen.empty()) http = std::make_unique<HttpServer>(context, config.http_listen, tls);
@@ -117,12 +131,15 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
   log_json(spdlog::level::info, "draining", {{"signal", signal_number}, {"queued", queue.waiting()}, {"running", queue.running()}});
   health.set_draining();
   queue.stop_accepting();
+  pair_queue.stop_accepting();  // a coordinator retries its pairs elsewhere
   const auto grace = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(config.drain_grace_s));
   if (!queue.wait_idle(Clock::now() + grace)) {
     log_json(spdlog::level::warn, "drain grace period over, cancelling jobs",
              {{"queued", queue.waiting()}, {"running", queue.running()}});
     queue.cancel_all();
+    pair_queue.cancel_all();
     queue.wait_idle(Clock::now() + std::chrono::seconds(10));  // cancellation takes effect within ~100 ms
+    pair_queue.wait_idle(Clock::now() + std::chrono::seconds(10));
   }
   // HTTP answers of the finished jobs go out; bodies still arriving are cut.
   if (http) http->stop();

@@ -1,6 +1,7 @@
 #include "proto_convert.h"
 
 #include <bit>
+#include <cstring>
 #include <string>
 
 #include "k4reg/util/error.h"
@@ -138,6 +139,7 @@ void result_to_proto(const RegistrationResult& r, v1::RegistrationResult* m) {
   m->set_ambiguity_margin(r.ambiguity_margin);
   m->set_ambiguous(r.ambiguous);
   m->set_ambiguity_reason(r.ambiguity_reason);
+  m->set_well_supported(r.well_supported);
   m->set_min_scale_m_used(r.min_scale_m_used);
   m->set_overlap_used(r.overlap_used);
   m->clear_hypotheses();
@@ -161,6 +163,118 @@ void result_to_proto(const RegistrationResult& r, v1::RegistrationResult* m) {
     out->set_stage(t.stage);
     out->set_seconds(t.seconds);
   }
+}
+
+void params_to_proto(const RegistrationParams& p, v1::RegistrationParams* m) {
+  m->set_min_scale_m(p.min_scale_m);
+  m->set_overlap(p.overlap);
+  m->set_octaves(p.octaves);
+  m->set_scales_per_octave(p.scales_per_octave);
+  m->set_min_contrast(p.min_contrast);
+  const v1::KeypointSignal signals[] = {v1::KEYPOINT_SIGNAL_AUTO, v1::KEYPOINT_SIGNAL_INTENSITY,
+                                        v1::KEYPOINT_SIGNAL_GEOMETRIC};
+  m->set_signal(signals[static_cast<int>(p.signal)]);
+  const v1::CoarseMethod methods[] = {v1::COARSE_METHOD_KEYPOINT_4PCS, v1::COARSE_METHOD_PLAIN_4PCS};
+  m->set_method(methods[static_cast<int>(p.method)]);
+  m->set_plain_voxel_m(p.plain_voxel_m);
+  m->set_max_bases(p.max_bases);
+  m->set_hypotheses_kept(p.hypotheses_kept);
+  m->set_icp(p.icp);
+  m->set_icp_max_iterations(p.icp_max_iterations);
+  m->set_seed(p.seed);
+  m->set_threads(p.threads);
+  m->set_time_budget_s(p.time_budget_s);
+  const v1::FreeSpaceCheck checks[] = {v1::FREE_SPACE_CHECK_AUTO, v1::FREE_SPACE_CHECK_ON, v1::FREE_SPACE_CHECK_OFF};
+  m->set_free_space(checks[static_cast<int>(p.free_space)]);
+}
+
+namespace {
+
+template <typename T>
+std::vector<T> values_from_bytes(const std::string& bytes, const std::string& what) {
+  static_assert(std::endian::native == std::endian::little, "pair clouds are little-endian float32");
+  if (bytes.size() % sizeof(T) != 0) fail(ErrorCode::kInvalidArgument, what + ": not a whole number of values");
+  std::vector<T> values(bytes.size() / sizeof(T));
+  if (!values.empty()) std::memcpy(static_cast<void*>(values.data()), bytes.data(), bytes.size());
+  return values;
+}
+
+template <typename T>
+std::string bytes_of(const std::vector<T>& values) {
+  return std::string(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+}
+
+}  // namespace
+
+void cloud_to_proto(const PointCloud& cloud, const std::string& name, v1::PairCloud* m) {
+  m->set_name(name);
+  m->set_points_xyz(bytes_of(cloud.points));
+  m->set_intensity(bytes_of(cloud.intensity));
+  m->clear_origin_m();
+  m->mutable_origin_m()->Add(cloud.origin_m.data(), cloud.origin_m.data() + 3);
+}
+
+PointCloud cloud_from_proto(const v1::PairCloud& m, std::size_t max_points) {
+  const std::string name = m.name().empty() ? "pair cloud" : m.name();
+  PointCloud cloud;
+  cloud.points = values_from_bytes<Eigen::Vector3f>(m.points_xyz(), name + " points_xyz");
+  cloud.intensity = values_from_bytes<float>(m.intensity(), name + " intensity");
+  if (!cloud.intensity.empty() && cloud.intensity.size() != cloud.points.size())
+    fail(ErrorCode::kInvalidArgument, name + ": intensity must be empty or one value per point");
+  if (max_points > 0 && cloud.points.size() > max_points)
+    fail(ErrorCode::kResourceExhausted, name + ": " + std::to_string(cloud.points.size()) + " points, more than " +
+                                            std::to_string(max_points) + " (--max-points)");
+  if (m.origin_m_size() != 3) fail(ErrorCode::kInvalidArgument, name + ": origin_m must have 3 values");
+  cloud.origin_m = Eigen::Vector3d(m.origin_m(0), m.origin_m(1), m.origin_m(2));
+  if (!cloud.origin_m.allFinite()) fail(ErrorCode::kInvalidArgument, name + ": origin_m is not finite");
+  for (const Eigen::Vector3f& p : cloud.points)
+    if (!p.allFinite()) fail(ErrorCode::kInvalidArgument, name + ": a point is NaN or infinite");
+  return cloud;
+}
+
+Eigen::Matrix4d matrix_from_proto(const google::protobuf::RepeatedField<double>& values) {
+  if (values.size() != 16) fail(ErrorCode::kInvalidArgument, "a transform must have 16 numbers");
+  Eigen::Matrix4d m;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) m(r, c) = values[4 * r + c];
+  return m;
+}
+
+RegistrationResult result_from_proto(const v1::RegistrationResult& m) {
+  auto points = [](const google::protobuf::RepeatedField<double>& values) {
+    if (values.size() % 3 != 0) fail(ErrorCode::kInvalidArgument, "point coordinates must come in threes");
+    std::vector<Eigen::Vector3d> out;
+    for (int i = 0; i < values.size(); i += 3) out.emplace_back(values[i], values[i + 1], values[i + 2]);
+    return out;
+  };
+  RegistrationResult r;
+  r.transform = matrix_from_proto(m.transform());
+  r.rmse_m = m.rmse_m();
+  r.overlap = m.overlap();
+  r.inliers = m.inliers();
+  r.source_points = m.source_points();
+  r.target_points = m.target_points();
+  r.source_voxels = m.source_voxels();
+  r.target_voxels = m.target_voxels();
+  r.source_keypoints = m.source_keypoints();
+  r.target_keypoints = m.target_keypoints();
+  r.signal = m.signal();
+  r.ambiguity_margin = m.ambiguity_margin();
+  r.ambiguous = m.ambiguous();
+  r.ambiguity_reason = m.ambiguity_reason();
+  r.well_supported = m.well_supported();
+  r.min_scale_m_used = m.min_scale_m_used();
+  r.overlap_used = m.overlap_used();
+  for (const v1::Hypothesis& h : m.hypotheses())
+    r.hypotheses.push_back({matrix_from_proto(h.transform()), h.keypoint_score(), h.cloud_score(), h.refined_score(),
+                            h.surface_agreement(), points(h.base_source_m()), points(h.base_target_m())});
+  if (r.hypotheses.empty()) fail(ErrorCode::kInvalidArgument, "a result without hypotheses");
+  r.bases_tried = m.bases_tried();
+  r.seed = m.seed();
+  r.icp_converged = m.icp_converged();
+  r.icp_iterations = m.icp_iterations();
+  for (const v1::StageTiming& t : m.timings()) r.timings.push_back({t.stage(), t.seconds()});
+  return r;
 }
 
 }  // namespace k4reg::service

@@ -20,6 +20,19 @@ void points_to_proto(const std::vector<Eigen::Vector3d>& points, google::protobu
 std::size_t preview_points_from_proto(std::uint32_t points);
 void preview_to_proto(const CloudPreview& preview, v1::Preview* message);
 
+// Every field set (the peer's defaults must not apply): the parameters a pair job is sent with.
+void params_to_proto(const RegistrationParams& params, v1::RegistrationParams* message);
+
+// A cloud as the core holds it, for RegisterPair; the inverse refuses malformed or non-finite clouds
+// (kInvalidArgument) and clouds over max_points (kResourceExhausted; 0 = unlimited).
+void cloud_to_proto(const PointCloud& cloud, const std::string& name, v1::PairCloud* message);
+PointCloud cloud_from_proto(const v1::PairCloud& message, std::size_t max_points);
+
+// A peer's result back into the core's struct (RegisterPair). Throws k4reg::Error(kInvalidArgument) for a
+// malformed one.
+RegistrationResult result_from_proto(const v1::RegistrationResult& message);
+Eigen::Matrix4d matrix_from_proto(const google::protobuf::RepeatedField<double>& values);
+
 // Row-major 4x4 -> 16 repeated doubles.
 void matrix_to_proto(const Eigen::Matrix4d& matrix, google::protobuf::RepeatedField<double>* values);
 

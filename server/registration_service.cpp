@@ -1,5 +1,6 @@
 #include "registration_service.h"
 
+#include "pair_reactor.h"
 #include "project_reactor.h"
 #include "register_reactor.h"
 #include "stream_reactor.h"
@@ -21,6 +22,12 @@ grpc::ServerBidiReactor<v1::RegisterStreamRequest, v1::RegisterStreamResponse>* 
 grpc::ServerWriteReactor<v1::RegisterProjectEvent>* RegistrationService::RegisterProject(
     grpc::CallbackServerContext* context, const v1::RegisterProjectRequest* request) {
   return new ProjectReactor(context_, context, request);
+}
+
+grpc::ServerUnaryReactor* RegistrationService::RegisterPair(grpc::CallbackServerContext* context,
+                                                            const v1::RegisterPairRequest* request,
+                                                            v1::RegisterPairResponse* reply) {
+  return new PairReactor(context_, context, request, reply);
 }
 
 }  // namespace k4reg::service

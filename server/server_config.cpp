@@ -32,6 +32,19 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
   app.add_option("--queue-size", c.queue_size, "jobs that may wait for a worker; beyond: RESOURCE_EXHAUSTED")
       ->envname("K4REG_QUEUE_SIZE")
       ->capture_default_str();
+  app.add_option("--peers", c.peers,
+                 "gRPC target of the replicas a project's pairs are sent to (e.g. dns:///k4reg-headless:50051, round "
+                 "robin over its addresses); empty = every pair in this process")
+      ->envname("K4REG_PEERS");
+  app.add_option("--pair-workers", c.pair_workers, "pairs of other replicas' projects run at once, 0 = --workers")
+      ->envname("K4REG_PAIR_WORKERS");
+  app.add_option("--pair-queue-size", c.pair_queue_size, "pairs that may wait; beyond: RESOURCE_EXHAUSTED")
+      ->envname("K4REG_PAIR_QUEUE_SIZE")
+      ->capture_default_str();
+  app.add_option("--peer-in-flight", c.peer_in_flight, "pairs of one project out to the peers at once")
+      ->envname("K4REG_PEER_IN_FLIGHT")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1024));
   app.add_option("--job-threads", c.job_threads, "core threads per job (caps the request's params.threads)")
       ->envname("K4REG_JOB_THREADS")
       ->capture_default_str()
@@ -104,6 +117,8 @@ void finish_config(ServerConfig& c) {
     c.server_id = std::string(host) + ":" + std::to_string(getpid());
   }
   if (c.queue_size == 0) throw CLI::ValidationError("--queue-size", "must be at least 1");
+  if (c.pair_workers == 0) c.pair_workers = c.workers;
+  if (c.pair_queue_size == 0) throw CLI::ValidationError("--pair-queue-size", "must be at least 1");
 }
 
 nlohmann::json config_to_json(const ServerConfig& c) {
@@ -115,6 +130,10 @@ nlohmann::json config_to_json(const ServerConfig& c) {
           {"data_roots", c.data_roots},
           {"workers", c.workers},
           {"queue_size", c.queue_size},
+          {"peers", c.peers},
+          {"pair_workers", c.pair_workers},
+          {"pair_queue_size", c.pair_queue_size},
+          {"peer_in_flight", c.peer_in_flight},
           {"job_threads", c.job_threads},
           {"max_points", c.max_points},
           {"memory_budget_mb", c.memory_budget_mb},

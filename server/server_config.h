@@ -18,6 +18,10 @@ struct ServerConfig {
   std::vector<std::string> data_roots;        // referenced files must lie under one of these
   std::size_t workers = 0;                    // 0 = number of cores
   std::size_t queue_size = 16;                // waiting jobs beyond the running ones
+  std::string peers;                          // gRPC target of the replicas project pairs go to; "" = in process
+  std::size_t pair_workers = 0;               // RegisterPair jobs at once (peers' pairs); 0 = workers
+  std::size_t pair_queue_size = 16;           // RegisterPair jobs waiting; beyond: RESOURCE_EXHAUSTED (backpressure)
+  int peer_in_flight = 4;                     // a coordinated project's pairs out at once
   int job_threads = 1;                        // core threads per job; parallelism comes from the workers
   std::size_t max_points = 50'000'000;        // per cloud; 0 = unlimited
   std::size_t memory_budget_mb = 0;           // for all running jobs; 0 = half the physical memory

@@ -33,7 +33,9 @@ grpc::Status ServiceContext::readiness() const {
   return grpc::Status::OK;
 }
 
-grpc::Status ServiceContext::submit(std::shared_ptr<Job> job, std::size_t& position) const {
+namespace {
+
+grpc::Status submit_to(JobQueue& queue, Metrics& metrics, std::shared_ptr<Job> job, std::size_t& position) {
   const JobQueue::Submission submission = queue.submit(std::move(job));
   position = submission.position;
   switch (submission.admission) {
@@ -50,11 +52,25 @@ grpc::Status ServiceContext::submit(std::shared_ptr<Job> job, std::size_t& posit
   return {grpc::StatusCode::UNAVAILABLE, kDraining};
 }
 
-bool ServiceContext::withdraw(const Job* job) const {
+bool withdraw_from(JobQueue& queue, Metrics& metrics, const Job* job) {
   if (!queue.withdraw(job)) return false;
   metrics.job_cancelled();
   return true;
 }
+
+}  // namespace
+
+grpc::Status ServiceContext::submit(std::shared_ptr<Job> job, std::size_t& position) const {
+  return submit_to(queue, metrics, std::move(job), position);
+}
+
+bool ServiceContext::withdraw(const Job* job) const { return withdraw_from(queue, metrics, job); }
+
+grpc::Status ServiceContext::submit_pair(std::shared_ptr<Job> job, std::size_t& position) const {
+  return submit_to(pair_queue, metrics, std::move(job), position);
+}
+
+bool ServiceContext::withdraw_pair(const Job* job) const { return withdraw_from(pair_queue, metrics, job); }
 
 CloudSource ServiceContext::referenced_cloud(const std::string& path) const { return {path, paths.resolve(path), {}}; }
 

@@ -23,6 +23,7 @@ namespace k4reg::service {
 
 struct ServiceContext {
   JobQueue& queue;
+  JobQueue& pair_queue;  // RegisterPair jobs from coordinating peers: their own workers, so projects cannot deadlock
   MemoryBudget& memory;
   const PathPolicy& paths;
   SpoolDir& spool;
@@ -42,6 +43,12 @@ struct ServiceContext {
   grpc::Status submit(std::shared_ptr<Job> job, std::size_t& position) const;
   // Takes a job out of the queue before a worker picks it up (JobQueue::withdraw); true = it will never run.
   bool withdraw(const Job* job) const;
+  // The same on the pair queue.
+  grpc::Status submit_pair(std::shared_ptr<Job> job, std::size_t& position) const;
+  bool withdraw_pair(const Job* job) const;
+  // k4reg-server --peers: where project pairs go (null = in process), and how.
+  std::shared_ptr<grpc::Channel> peers;
+  int peer_in_flight = 4;
   // A file reference as the worker will read it (throws k4reg::Error, see PathPolicy::resolve).
   CloudSource referenced_cloud(const std::string& path) const;
   // A RegisterRequest's cloud: a reference or inline bytes (which the request owns). Throws k4reg::Error.

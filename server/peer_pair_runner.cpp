@@ -1,0 +1,148 @@
+#include "peer_pair_runner.h"
+
+#include <chrono>
+#include <mutex>
+#include <thread>
+
+#include "k4reg/v1/registration.grpc.pb.h"
+#include "proto_convert.h"
+#include "status_mapping.h"
+
+namespace k4reg::service {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The calls in flight, so that the coordinator's cancellation reaches every one of them.
+class OutstandingCalls {
+ public:
+  void add(grpc::ClientContext* context) {
+    const std::lock_guard lock(mutex_);
+    calls_.push_back(context);
+    if (cancelled_) context->TryCancel();
+  }
+  void remove(grpc::ClientContext* context) {
+    const std::lock_guard lock(mutex_);
+    std::erase(calls_, context);
+  }
+  void cancel_all() {
+    const std::lock_guard lock(mutex_);
+    cancelled_ = true;
+    for (grpc::ClientContext* context : calls_) context->TryCancel();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<grpc::ClientContext*> calls_;
+  bool cancelled_ = false;
+};
+
+// A peer's answer that is the pair's own outcome (the same as running it here would give), not the peer's trouble.
+bool is_pair_outcome(grpc::StatusCode code) {
+  return code == grpc::StatusCode::FAILED_PRECONDITION || code == grpc::StatusCode::INVALID_ARGUMENT;
+}
+
+}  // namespace
+
+PeerPairRunner::PeerPairRunner(std::shared_ptr<grpc::Channel> peers, PeerOptions options, PairPlacement& placement)
+    : peers_(std::move(peers)), options_(std::move(options)), placement_(placement) {}
+
+void PeerPairRunner::run(const std::vector<PointCloud>& scans, const std::vector<ScanPair>& pairs,
+                         const RegistrationParams& params, const CancellationToken* cancel, const Done& done) {
+  // Each scan is encoded once, whatever the number of pairs it is in.
+  std::vector<v1::PairCloud> clouds(scans.size());
+  for (std::size_t i = 0; i < scans.size(); ++i) cloud_to_proto(scans[i], "scan " + std::to_string(i), &clouds[i]);
+  v1::RegistrationParams sent;
+  params_to_proto(params, &sent);
+  auto stub = v1::Registration::NewStub(peers_);
+
+  std::mutex mutex;  // guards next, done() and failure
+  std::size_t next = 0;
+  std::exception_ptr failure;
+  OutstandingCalls calls;
+  std::atomic<bool> stop{false};
+  std::atomic<int> running{0};  // workers not yet finished
+
+  // One pair, on a peer if one answers, else here.
+  auto register_one = [&](std::size_t k) {
+    const auto start = Clock::now();
+    double backoff = options_.first_backoff_s;
+    for (int failed = 0; failed < options_.attempts && !stop;) {
+      v1::RegisterPairRequest request;
+      *request.mutable_source() = clouds[pairs[k].first];
+      *request.mutable_target() = clouds[pairs[k].second];
+      *request.mutable_params() = sent;
+      grpc::ClientContext context;
+      context.AddMetadata("x-request-id", options_.request_id);
+      if (!options_.auth_token.empty()) context.AddMetadata("authorization", "Bearer " + options_.auth_token);
+      v1::RegisterPairResponse reply;
+      calls.add(&context);
+      const grpc::Status status = stub->RegisterPair(&context, request, &reply);
+      calls.remove(&context);
+      if (status.ok() || is_pair_outcome(status.error_code())) {
+        PairOutcome outcome;
+        if (status.ok())
+          outcome.result = result_from_proto(reply.result());
+        else
+          outcome.error = Error(status.error_code() == grpc::StatusCode::FAILED_PRECONDITION ? ErrorCode::kFailedPrecondition
+                                                                                              : ErrorCode::kInvalidArgument,
+                                status.error_message());
+        outcome.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+        ++placement_.on_peers;
+        return outcome;
+      }
+      if (stop) break;
+      if (status.error_code() != grpc::StatusCode::RESOURCE_EXHAUSTED) ++failed;  // backpressure is no failure
+      ++placement_.retried;
+      std::this_thread::sleep_for(std::chrono::duration<double>(backoff));
+      backoff = std::min(2.0 * backoff, options_.max_backoff_s);
+    }
+    check(cancel);
+    ++placement_.local;
+    return register_pair(scans[pairs[k].first], scans[pairs[k].second], params, cancel);
+  };
+
+  auto worker = [&] {
+    struct Exit {
+      std::atomic<int>& running;
+      ~Exit() { --running; }
+    } exit{running};
+    for (;;) {
+      std::size_t k;
+      {
+        const std::lock_guard lock(mutex);
+        if (stop || next >= pairs.size()) return;
+        k = next++;
+      }
+      try {
+        PairOutcome outcome = register_one(k);
+        const std::lock_guard lock(mutex);
+        if (!stop) done(k, std::move(outcome));
+      } catch (...) {
+        const std::lock_guard lock(mutex);
+        if (!failure) failure = std::current_exception();
+        stop = true;
+        calls.cancel_all();
+        return;
+      }
+    }
+  };
+  std::vector<std::thread> workers;
+  const int count = std::max(1, std::min<int>(options_.in_flight, static_cast<int>(pairs.size())));
+  running = count;
+  for (int w = 0; w < count; ++w) workers.emplace_back(worker);
+  // The coordinator's cancellation or deadline reaches the calls in flight within 50 ms.
+  while (running > 0) {
+    if (cancel && (cancel->cancelled() || cancel->deadline_passed())) {
+      stop = true;
+      calls.cancel_all();
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  for (std::thread& t : workers) t.join();
+  if (failure) std::rethrow_exception(failure);
+  check(cancel);
+}
+
+}  // namespace k4reg::service
