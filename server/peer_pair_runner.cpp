@@ -12,6 +12,7 @@ namespace k4reg::service {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+constexpr int kMaxBackpressureWaits = 20;
 
 // The calls in flight, so that the coordinator's cancellation reaches every one of them.
 class OutstandingCalls {
@@ -67,6 +68,7 @@ void PeerPairRunner::run(const std::vector<PointCloud>& scans, const std::vector
   auto register_one = [&](std::size_t k) {
     const auto start = Clock::now();
     double backoff = options_.first_backoff_s;
+    int waits = 0;
     for (int failed = 0; failed < options_.attempts && !stop;) {
       v1::RegisterPairRequest request;
       *request.mutable_source() = clouds[pairs[k].first];
@@ -92,7 +94,9 @@ void PeerPairRunner::run(const std::vector<PointCloud>& scans, const std::vector
         return outcome;
       }
       if (stop) break;
-      if (status.error_code() != grpc::StatusCode::RESOURCE_EXHAUSTED) ++failed;  // backpressure is no failure
+      // Backpressure is no failure, but a pair no peer ever takes (one over a peer's message limit, say) must
+      // not wait forever: kMaxBackpressureWaits waits count as one failure.
+      if (status.error_code() != grpc::StatusCode::RESOURCE_EXHAUSTED || ++waits % kMaxBackpressureWaits == 0) ++failed;
       ++placement_.retried;
       std::this_thread::sleep_for(std::chrono::duration<double>(backoff));
       backoff = std::min(2.0 * backoff, options_.max_backoff_s);
