@@ -1,5 +1,6 @@
 #include "project_mapping.h"
 
+#include "messages_to_core.h"
 #include "proto_mapping.h"
 
 namespace k4reg::cli {
@@ -9,7 +10,7 @@ ProjectResult project_result_from_proto(const v1::ProjectResult& m) {
   for (const v1::ProjectScan& s : m.scans()) {
     ProjectScan scan;
     scan.registered = s.registered();
-    if (s.pose_size() == 16) scan.pose = matrix_from_proto(s.pose());
+    if (s.pose_size() == 16) scan.pose = api::matrix_from_proto(s.pose());
     scan.links.assign(s.links().begin(), s.links().end());
     scan.points = s.points();
     scan.strength = s.strength();
@@ -20,7 +21,7 @@ ProjectResult project_result_from_proto(const v1::ProjectResult& m) {
     ProjectLink link;
     link.source = l.source();
     link.target = l.target();
-    if (l.transform_size() == 16) link.transform = matrix_from_proto(l.transform());
+    if (l.transform_size() == 16) link.transform = api::matrix_from_proto(l.transform());
     link.rmse_m = l.rmse_m();
     link.overlap = l.overlap();
     link.cloud_score = l.cloud_score();

@@ -10,6 +10,7 @@
 #include "k4reg/io/matrix_file.h"
 #include "progress_bar.h"
 #include "qa_report.h"
+#include "messages_to_core.h"
 #include "proto_mapping.h"
 #include "registration_flags.h"
 #include "remote_registration.h"
@@ -49,7 +50,7 @@ void run_register(const RegisterOptions& o) {
                          o.progress || isatty(STDERR_FILENO) ? ProgressBar::Style::kBar : ProgressBar::Style::kLines);
     response = register_remote(make_channel(o.connection), o.connection, job, policy, progress);
   }
-  const RegistrationResult result = result_from_proto(response.result());
+  const RegistrationResult result = api::result_from_proto(response.result());
   if (!o.out.empty()) write_matrix4(o.out, result.transform);
   // align's layout, plus where and how the job ran.
   nlohmann::json json = result_to_json(result);
@@ -57,7 +58,7 @@ void run_register(const RegisterOptions& o) {
   json["server"] = {{"version", response.server().version()}, {"server_id", response.server().server_id()}};
   json["server_timings"] = server_timings_to_json(response.timings());
   if (o.report.wanted()) {
-    const CloudPreview preview = preview_from_proto(response.preview());
+    const CloudPreview preview = api::preview_from_proto(response.preview());
     write_pair_report(o.report, "k4reg register", o.source, o.target, o.params, json, &preview);
   }
   if (o.json) {

@@ -14,6 +14,7 @@
 #include "project_mapping.h"
 #include "project_report.h"
 #include "qa_report.h"
+#include "messages_to_core.h"
 #include "proto_mapping.h"
 #include "registration_flags.h"
 #include "server_timings.h"
@@ -92,9 +93,13 @@ void run_register_project(const RegisterProjectOptions& o) {
   json["request_id"] = response.request_id();
   json["server"] = {{"version", response.server().version()}, {"server_id", response.server().server_id()}};
   json["server_timings"] = server_timings_to_json(response.timings());
+  // Where the pairs ran: on the deployment's peers (k4reg-server --peers) or on the replica that answered.
+  json["pairs_on_peers"] = response.pairs_on_peers();
+  json["pairs_local"] = response.pairs_local();
+  json["pair_retries"] = response.pair_retries();
   if (!o.flags.out_dir.empty()) write_project_dir(o.flags.out_dir, result, origins, json);
   if (o.report.wanted()) {
-    const CloudPreview preview = preview_from_proto(response.preview());
+    const CloudPreview preview = api::preview_from_proto(response.preview());
     write_project_report(o.report, "k4reg register-project", o.scans, params, json, &preview);
   }
   if (o.flags.json)

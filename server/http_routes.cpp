@@ -47,6 +47,9 @@ void handle_metrics(const ServiceContext& service, HttpExchange& exchange) {
   snapshot.queue_capacity = service.queue.capacity();
   snapshot.workers_busy = service.queue.running();
   snapshot.workers = service.queue.workers();
+  snapshot.pair_queue_depth = service.pair_queue.waiting();
+  snapshot.pair_workers_busy = service.pair_queue.running();
+  snapshot.pair_workers = service.pair_queue.workers();
   snapshot.memory_reserved_bytes = service.memory.in_use();
   exchange.reply(200, service.metrics.exposition(snapshot), kPrometheusContentType);
 }

@@ -20,6 +20,7 @@
 #include "http_server.h"
 #include "json_log.h"
 #include "metrics.h"
+#include "peer_channel.h"
 #include "registration_service.h"
 #include "server_config.h"
 #include "tls.h"
@@ -32,9 +33,9 @@ using Clock = std::chrono::steady_clock;
 int milliseconds(double seconds) { return static_cast<int>(std::min(seconds * 1000.0, 2.0e9)); }
 
 void set_connection_options(grpc::ServerBuilder& builder, const ServerConfig& config) {
-  // A peer's pair (RegisterPair) carries two clouds of up to --max-points at 16 bytes per point, within gRPC's 2 GiB.
-  // TODO(issue 23): enforce --max-inline-mb on Register/RegisterProject themselves once this limit is raised.
-  builder.SetMaxReceiveMessageSize(static_cast<int>((config.max_inline_mb << 20) + (64 << 10)));
+  // The largest message is a peer's pair job (--max-pair-mb); Register and RegisterProject check --max-inline-mb.
+  const double limit_mb = std::max(static_cast<double>(config.max_inline_mb), config.max_pair_mb);
+  builder.SetMaxReceiveMessageSize(static_cast<int>(limit_mb * (1 << 20)) + (64 << 10));
   builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, milliseconds(config.keepalive_time_s));
   builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, 20'000);
   // Clients waiting minutes for a job may ping to keep NATs and proxies open; allow it every 10 s.
@@ -66,27 +67,20 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
   info.set_version(K4REG_VERSION);
   info.set_server_id(config.server_id);
   Metrics metrics(K4REG_VERSION);
-  ServiceContext context{queue,
-                               pair_queue,
-                               memory,
-                               paths,
-                               spool,
-                               JobLimits{config.max_points, config.job_threads},
-                               config.auth_token,
-                               std::uint64_t(config.max_upload_mb) << 20,
-                               std::uint64_t(config.max_inline_mb) << 20,
-                               info,
-                               metrics};
-  if (!config.peers.empty()) {
-    grpc::ChannelArguments arguments;
-    arguments.SetLoadBalancingPolicyName("round_robin");
-    arguments.SetMaxSendMessageSize(-1);
-    // Peers speak the same TLS as this replica; a client certificate, where required, is not sent yet.
-    context.peers = grpc::CreateCustomChannel(
-        config.peers, tls ? grpc::SslCredentials(grpc::SslCredentialsOptions{}) : grpc::InsecureChannelCredentials(),
-        arguments);
-    context.peer_in_flight = config.peer_in_flight;
-  }
+  const ServiceContext context{queue,
+                         pair_queue,
+                         memory,
+                         paths,
+                         spool,
+                         JobLimits{config.max_points, config.job_threads},
+                         config.auth_token,
+                         std::uint64_t(config.max_upload_mb) << 20,
+                         std::uint64_t(config.max_inline_mb) << 20,
+                         info,
+                         metrics,
+                         config.peers.empty() ? nullptr : make_peer_channel(config.peers, tls),
+                         PeerOptions{.in_flight = config.peer_in_flight,
+                                     .max_pair_bytes = static_cast<std::uint64_t>(config.max_pair_mb * (1 << 20))}};
   RegistrationService service(context);
   std::unique_ptr<HttpServer> http;
   if (!config.http_listen.empty()) http = std::make_unique<HttpServer>(context, config.http_listen, tls);
@@ -133,7 +127,9 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
   queue.stop_accepting();
   pair_queue.stop_accepting();  // a coordinator retries its pairs elsewhere
   const auto grace = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(config.drain_grace_s));
-  if (!queue.wait_idle(Clock::now() + grace)) {
+  const auto grace_end = Clock::now() + grace;
+  const bool idle = queue.wait_idle(grace_end);
+  if (!pair_queue.wait_idle(grace_end) || !idle) {
     log_json(spdlog::level::warn, "drain grace period over, cancelling jobs",
              {{"queued", queue.waiting()}, {"running", queue.running()}});
     queue.cancel_all();

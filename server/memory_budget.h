@@ -10,6 +10,7 @@
 #include <condition_variable>
 #include <cstddef>
 #include <mutex>
+#include <optional>
 
 #include "k4reg/util/cancellation.h"
 
@@ -40,11 +41,15 @@ class MemoryBudget {
   // k4reg::Error: kResourceExhausted if `bytes` exceed the whole budget, kCancelled / kDeadlineExceeded
   // if the token fires while waiting.
   Reservation reserve(std::size_t bytes, const CancellationToken& token);
+  // The same without waiting: nullopt when `bytes` do not fit now. For jobs whose waiting could close a cycle (a
+  // peer's pair job, waited for by a project that holds memory on another replica).
+  std::optional<Reservation> try_reserve(std::size_t bytes);
 
   std::size_t in_use() const;
 
  private:
   void release(std::size_t bytes);
+  void check_within_budget(std::size_t bytes) const;  // throws kResourceExhausted
 
   const std::size_t budget_;
   mutable std::mutex mutex_;

@@ -144,6 +144,26 @@ void Metrics::job_rejected(std::string_view reason) {
   rejected_[labels({{"reason", reason}})] += 1;
 }
 
+void Metrics::peer_pair_sent(std::string_view peer) {
+  std::lock_guard lock(mutex_);
+  peer_sent_[labels({{"peer", peer}})] += 1;
+}
+
+void Metrics::peer_pair_retried(std::string_view peer, std::string_view code) {
+  std::lock_guard lock(mutex_);
+  peer_retried_[labels({{"peer", peer}, {"code", code}})] += 1;
+}
+
+void Metrics::peer_pair_failed(std::string_view reason) {
+  std::lock_guard lock(mutex_);
+  peer_failed_[labels({{"reason", reason}})] += 1;
+}
+
+void Metrics::pair_job_received(std::string_view code) {
+  std::lock_guard lock(mutex_);
+  pairs_received_[labels({{"code", code}})] += 1;
+}
+
 std::string Metrics::exposition(const Snapshot& s) const {
   std::string out;
   header(out, "k4reg_build_info", "gauge", "Build of the k4reg server (always 1).");
@@ -166,11 +186,22 @@ std::string Metrics::exposition(const Snapshot& s) const {
            cancelled_);
     family(out, "k4reg_jobs_rejected_total", "counter", "Jobs the queue refused, by reason (queue_full, draining).",
            rejected_);
+    family(out, "k4reg_peer_pairs_sent_total", "counter", "Pair jobs this coordinator sent, by peer address.", peer_sent_);
+    family(out, "k4reg_peer_pairs_retried_total", "counter",
+           "Pair calls that failed and were tried again, by peer address and status code.", peer_retried_);
+    family(out, "k4reg_peer_pairs_failed_total", "counter",
+           "Pairs no peer registered, run by this coordinator, by reason (peers_failed, too_large).", peer_failed_);
+    family(out, "k4reg_pair_jobs_received_total", "counter", "Pair jobs received from coordinators, by status code.",
+           pairs_received_);
   }
   metric(out, "k4reg_queue_depth", "gauge", "Jobs waiting for a worker.", double(s.queue_depth));
   metric(out, "k4reg_queue_capacity", "gauge", "Jobs that may wait for a worker (--queue-size).", double(s.queue_capacity));
   metric(out, "k4reg_workers_busy", "gauge", "Workers running a job.", double(s.workers_busy));
   metric(out, "k4reg_workers", "gauge", "Workers (--workers).", double(s.workers));
+  metric(out, "k4reg_pair_queue_depth", "gauge", "Pair jobs of other replicas' projects waiting.",
+         double(s.pair_queue_depth));
+  metric(out, "k4reg_pair_workers_busy", "gauge", "Pair workers running a job.", double(s.pair_workers_busy));
+  metric(out, "k4reg_pair_workers", "gauge", "Pair workers (--pair-workers).", double(s.pair_workers));
   metric(out, "k4reg_memory_reserved_bytes", "gauge", "Estimated memory reserved by running jobs.",
          double(s.memory_reserved_bytes));
   process_metrics(out, start_time_s_);

@@ -1,7 +1,9 @@
 #include "pair_reactor.h"
 
+#include "k4reg/util/error.h"
 #include "proto_convert.h"
 #include "status_mapping.h"
+#include "status_name.h"
 
 namespace k4reg::service {
 
@@ -34,8 +36,10 @@ void PairReactor::execute(Job& job) {
   grpc::Status status;
   try {
     job.token().throw_if_stopped();  // cancelled or expired while queued
-    const MemoryBudget::Reservation reservation =
-        service_.memory.reserve(kBytesPerPoint * (source_.size() + target_.size()), job.token());
+    // No waiting for memory: the coordinator's project may be what holds it (here or on its replica), so a busy
+    // budget is backpressure the coordinator answers by trying elsewhere or later.
+    const auto reservation = service_.memory.try_reserve(kBytesPerPoint * (source_.size() + target_.size()));
+    if (!reservation) fail(ErrorCode::kResourceExhausted, "the memory budget is in use by other jobs; try again later");
     if (params_.threads == 0 || params_.threads > service_.limits.job_threads) params_.threads = service_.limits.job_threads;
     result_to_proto(register_clouds(source_, target_, params_, &job.token()), reply_->mutable_result());
     *reply_->mutable_server() = service_.server_info;
@@ -55,6 +59,7 @@ void PairReactor::finish(const grpc::Status& status) {
   if (finished_.exchange(true)) return;
   record_.code = status.error_code();
   record_.error = status.error_message();
+  service_.metrics.pair_job_received(status_code_name(status.error_code()));
   service_.end_request(record_);
   Finish(status);
 }

@@ -5,8 +5,10 @@
 #include <thread>
 
 #include "k4reg/v1/registration.grpc.pb.h"
+#include "messages_to_core.h"
+#include "metrics.h"
 #include "proto_convert.h"
-#include "status_mapping.h"
+#include "status_name.h"
 
 namespace k4reg::service {
 namespace {
@@ -45,8 +47,9 @@ bool is_pair_outcome(grpc::StatusCode code) {
 
 }  // namespace
 
-PeerPairRunner::PeerPairRunner(std::shared_ptr<grpc::Channel> peers, PeerOptions options, PairPlacement& placement)
-    : peers_(std::move(peers)), options_(std::move(options)), placement_(placement) {}
+PeerPairRunner::PeerPairRunner(std::shared_ptr<grpc::Channel> peers, const PeerOptions& options, PeerCaller caller,
+                               Metrics& metrics, PairPlacement& placement)
+    : peers_(std::move(peers)), options_(options), caller_(std::move(caller)), metrics_(metrics), placement_(placement) {}
 
 void PeerPairRunner::run(const std::vector<PointCloud>& scans, const std::vector<ScanPair>& pairs,
                          const RegistrationParams& params, const CancellationToken* cancel, const Done& done) {
@@ -69,22 +72,25 @@ void PeerPairRunner::run(const std::vector<PointCloud>& scans, const std::vector
     const auto start = Clock::now();
     double backoff = options_.first_backoff_s;
     int waits = 0;
-    for (int failed = 0; failed < options_.attempts && !stop;) {
-      v1::RegisterPairRequest request;
-      *request.mutable_source() = clouds[pairs[k].first];
-      *request.mutable_target() = clouds[pairs[k].second];
-      *request.mutable_params() = sent;
+    v1::RegisterPairRequest request;
+    *request.mutable_source() = clouds[pairs[k].first];
+    *request.mutable_target() = clouds[pairs[k].second];
+    *request.mutable_params() = sent;
+    const bool fits = request.ByteSizeLong() <= options_.max_pair_bytes;
+    for (int failed = 0; fits && failed < options_.attempts && !stop;) {
       grpc::ClientContext context;
-      context.AddMetadata("x-request-id", options_.request_id);
-      if (!options_.auth_token.empty()) context.AddMetadata("authorization", "Bearer " + options_.auth_token);
+      context.AddMetadata("x-request-id", caller_.request_id);
+      if (!caller_.auth_token.empty()) context.AddMetadata("authorization", "Bearer " + caller_.auth_token);
       v1::RegisterPairResponse reply;
       calls.add(&context);
       const grpc::Status status = stub->RegisterPair(&context, request, &reply);
       calls.remove(&context);
+      const std::string peer = context.peer().empty() ? "none" : context.peer();
+      metrics_.peer_pair_sent(peer);
       if (status.ok() || is_pair_outcome(status.error_code())) {
         PairOutcome outcome;
         if (status.ok())
-          outcome.result = result_from_proto(reply.result());
+          outcome.result = api::result_from_proto(reply.result());
         else
           outcome.error = Error(status.error_code() == grpc::StatusCode::FAILED_PRECONDITION ? ErrorCode::kFailedPrecondition
                                                                                               : ErrorCode::kInvalidArgument,
@@ -94,15 +100,18 @@ void PeerPairRunner::run(const std::vector<PointCloud>& scans, const std::vector
         return outcome;
       }
       if (stop) break;
+      metrics_.peer_pair_retried(peer, status_code_name(status.error_code()));
       // Backpressure is no failure, but a pair no peer ever takes (one over a peer's message limit, say) must
       // not wait forever: kMaxBackpressureWaits waits count as one failure.
       if (status.error_code() != grpc::StatusCode::RESOURCE_EXHAUSTED || ++waits % kMaxBackpressureWaits == 0) ++failed;
       ++placement_.retried;
-      std::this_thread::sleep_for(std::chrono::duration<double>(backoff));
+      for (const auto until = Clock::now() + std::chrono::duration<double>(backoff); !stop && Clock::now() < until;)
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
       backoff = std::min(2.0 * backoff, options_.max_backoff_s);
     }
     check(cancel);
     ++placement_.local;
+    metrics_.peer_pair_failed(fits ? "peers_failed" : "too_large");
     return register_pair(scans[pairs[k].first], scans[pairs[k].second], params, cancel);
   };
 

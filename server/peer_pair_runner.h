@@ -1,30 +1,46 @@
 // k4reg-server --peers: the coordinating replica's PairRunner. It sends a project's pairs to the peers (a gRPC
 // target such as dns:///k4reg-headless.NS.svc.cluster.local:50051, round robin over its addresses) through
-// RegisterPair, with both clouds inline (12 bytes per point, 16 with intensity: about 34 MB for a pair of 1 M-point
-// scans with intensity), at most `in_flight` pairs at once. Nothing is lost: a peer that fails, drains or dies
-// mid-pair has the pair sent again after a backoff (RESOURCE_EXHAUSTED is backpressure: wait, do not count it), and
-// after `attempts` failures the pair runs here. The coordinator's cancellation cancels every outstanding call.
-// The peers compute register_clouds on the coordinator's own numbers, so the poses equal the in-process ones.
+// RegisterPair, at most `in_flight` pairs at once.
+//
+// What travels: both clouds of the pair as this replica holds them after reading (float32 x, y, z in a local
+// frame, float32 intensity when the scan has it, the frame's double origin) and every registration parameter:
+// 12 bytes per point, 16 with intensity, plus about 150 bytes; 34 MB for a pair of 1 M-point scans with
+// intensity. Each scan is encoded once per project. The peer computes register_clouds on exactly these numbers,
+// so the poses equal the in-process ones bit for bit.
+//
+// Nothing is lost: a call that fails (peer gone, draining, killed mid-pair) is sent again after a backoff, to
+// whichever peer the channel picks; RESOURCE_EXHAUSTED (the peer's pair queue is full) is backpressure: wait and
+// retry, counted as one failure only every 20 waits. After `attempts` failures, or when the pair is larger than a
+// peer accepts (max_pair_bytes), the pair runs here. The coordinator's cancellation or deadline cancels every
+// outstanding call within 50 ms.
 #pragma once
 
 #include <grpcpp/channel.h>
 
 #include <atomic>
+#include <cstdint>
 #include <memory>
 #include <string>
 
 #include "k4reg/project/pair_runner.h"
-#include "metrics.h"
 
 namespace k4reg::service {
 
+class Metrics;
+
 struct PeerOptions {
-  int in_flight = 4;            // pairs out at once
-  int attempts = 3;             // failed calls (not RESOURCE_EXHAUSTED) before a pair runs locally
-  double first_backoff_s = 0.2; // doubled after each try, at most max_backoff_s
+  int in_flight = 4;                       // pairs out at once
+  int attempts = 3;                        // failed calls (not RESOURCE_EXHAUSTED) before a pair runs here
+  double first_backoff_s = 0.2;            // doubled after each retry, at most max_backoff_s
   double max_backoff_s = 5.0;
-  std::string request_id;       // the project's: every pair call carries it (x-request-id), so logs tie them
-  std::string auth_token;       // sent to the peers when the deployment requires one
+  std::uint64_t max_pair_bytes = 1ull << 30;  // the peers' --max-pair-mb: larger pairs run here
+};
+
+// Who is asking: every pair call carries the project's request id (x-request-id, so the peers' logs tie the
+// pairs to the project) and the deployment's bearer token, if it has one.
+struct PeerCaller {
+  std::string request_id;
+  std::string auth_token;
 };
 
 // Where a project's pairs ran.
@@ -34,13 +50,16 @@ struct PairPlacement {
 
 class PeerPairRunner : public PairRunner {
  public:
-  PeerPairRunner(std::shared_ptr<grpc::Channel> peers, PeerOptions options, PairPlacement& placement);
+  PeerPairRunner(std::shared_ptr<grpc::Channel> peers, const PeerOptions& options, PeerCaller caller, Metrics& metrics,
+                 PairPlacement& placement);
   void run(const std::vector<PointCloud>& scans, const std::vector<ScanPair>& pairs, const RegistrationParams& params,
            const CancellationToken* cancel, const Done& done) override;
 
  private:
   std::shared_ptr<grpc::Channel> peers_;
   PeerOptions options_;
+  PeerCaller caller_;
+  Metrics& metrics_;
   PairPlacement& placement_;
 };
 

@@ -24,7 +24,7 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 ProjectOutcome run_project(const std::vector<CloudSource>& scans, const std::vector<std::string>& names,
                            ProjectParams params, std::size_t preview_points, const JobLimits& limits,
                            MemoryBudget& memory, const CancellationToken& token, const StageListener& stages,
-                           const PairListener& pairs, const PeerSetup& peers, ProjectReport& report) {
+                           const PairListener& pairs, PairRunner* runner, ProjectReport& report) {
   token.throw_if_stopped();  // cancelled or expired while queued
   StageTracker progress(stages);
   const auto load_start = Clock::now();
@@ -44,16 +44,7 @@ ProjectOutcome run_project(const std::vector<CloudSource>& scans, const std::vec
   if (params.pairwise.threads == 0 || params.pairwise.threads > limits.job_threads) params.pairwise.threads = limits.job_threads;
   const auto start = Clock::now();
   const ProgressCallback callback = [&](const std::string& stage, double fraction) { progress(stage, fraction); };
-  // With --peers the pairs go out to the deployment; the poses are the same either way.
-  PairPlacement placement;
-  std::optional<PeerPairRunner> runner;
-  if (peers.channel)
-    runner.emplace(peers.channel, PeerOptions{peers.in_flight, 3, 0.2, 5.0, peers.request_id, peers.auth_token}, placement);
-  ProjectOutcome outcome{register_project(clouds, params, &token, callback, pairs, runner ? &*runner : nullptr),
-                         std::nullopt};
-  report.pairs_on_peers = placement.on_peers;
-  report.pairs_local = placement.local;
-  report.pair_retries = placement.retried;
+  ProjectOutcome outcome{register_project(clouds, params, &token, callback, pairs, runner), std::nullopt};
   report.registration_s = seconds_since(start);
   outcome.preview = preview_stage(preview_points, progress, [&](const PreviewParams& preview) {
     return make_project_preview(clouds, names, outcome.result, preview, &token);
@@ -92,11 +83,18 @@ grpc::Status run_project_job(const ServiceContext& service, Job& job, const Proj
                              v1::RegisterProjectResponse& reply) {
   clock.job_start = CallClock::Clock::now();
   ProjectReport report;
+  PairPlacement placement;
   grpc::Status status;
   try {
-    const PeerSetup peers{service.peers, service.peer_in_flight, record.request_id, service.auth_token};
-    const ProjectOutcome outcome = run_project(project.scans, project.names, project.params, project.preview_points,
-                                               service.limits, service.memory, job.token(), stages, pairs, peers, report);
+    // With --peers the pairs go out to the deployment; the poses are the same either way.
+    std::optional<PeerPairRunner> runner;
+    if (service.peers)
+      runner.emplace(service.peers, service.peer_options, PeerCaller{record.request_id, service.auth_token},
+                     service.metrics, placement);
+    const ProjectOutcome outcome =
+        run_project(project.scans, project.names, project.params, project.preview_points, service.limits,
+                    service.memory, job.token(), stages, pairs, runner ? &*runner : nullptr, report);
+    if (!runner) placement.local = outcome.result.links.size();  // one link per pair
     project_result_to_proto(outcome.result, project.names, reply.mutable_result());
     if (outcome.preview) preview_to_proto(*outcome.preview, reply.mutable_preview());
   } catch (...) {
@@ -111,9 +109,9 @@ grpc::Status run_project_job(const ServiceContext& service, Job& job, const Proj
     service.metrics.job_cancelled();
   if (status.ok()) {
     fill_timings(clock, report.load_s, report.registration_s, *reply.mutable_timings());
-    reply.set_pairs_on_peers(static_cast<std::uint32_t>(report.pairs_on_peers));
-    reply.set_pairs_local(static_cast<std::uint32_t>(report.pairs_local));
-    reply.set_pair_retries(static_cast<std::uint32_t>(report.pair_retries));
+    reply.set_pairs_on_peers(static_cast<std::uint32_t>(placement.on_peers.load()));
+    reply.set_pairs_local(static_cast<std::uint32_t>(placement.local.load()));
+    reply.set_pair_retries(static_cast<std::uint32_t>(placement.retried.load()));
     *reply.mutable_server() = service.server_info;
     reply.set_request_id(record.request_id);
   }

@@ -2,8 +2,6 @@
 // reserve their memory, run the core's register_project with stage and pair events.
 #pragma once
 
-#include <grpcpp/channel.h>
-
 #include <functional>
 #include <optional>
 #include <vector>
@@ -18,14 +16,6 @@ namespace k4reg::service {
 struct ProjectReport {
   std::uint64_t points = 0;  // all scans
   double load_s = 0, registration_s = 0;
-  std::size_t pairs_on_peers = 0, pairs_local = 0, pair_retries = 0;  // with --peers
-};
-
-// Where a project's pairs go: the deployment's peers (k4reg-server --peers), or in process when `channel` is null.
-struct PeerSetup {
-  std::shared_ptr<grpc::Channel> channel;
-  int in_flight = 4;
-  std::string request_id, auth_token;
 };
 
 // Called on the worker thread after each pair.
@@ -43,7 +33,7 @@ struct ProjectOutcome {
 ProjectOutcome run_project(const std::vector<CloudSource>& scans, const std::vector<std::string>& names,
                            ProjectParams params, std::size_t preview_points, const JobLimits& limits,
                            MemoryBudget& memory, const CancellationToken& token, const StageListener& stages,
-                           const PairListener& pairs, const PeerSetup& peers, ProjectReport& report);
+                           const PairListener& pairs, PairRunner* runner, ProjectReport& report);
 
 // A project request as the worker will run it: its scans (references resolved, inline bytes owned by the
 // request) and parameters. Throws k4reg::Error for fewer than 2 scans, a scan given twice by path, bad

@@ -14,6 +14,7 @@ ProjectReactor::ProjectReactor(ServiceContext& service, grpc::CallbackServerCont
     return;
   }
   try {
+    service_.check_inline_size(request->ByteSizeLong());
     project_ = project_job_from_proto(service_, *request);  // inline bytes stay owned by the request
   } catch (...) {
     finish(status_from_current_exception());

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "k4reg/util/error.h"
+#include "messages_to_core.h"
 
 namespace k4reg::service {
 namespace {
@@ -191,15 +192,6 @@ void params_to_proto(const RegistrationParams& p, v1::RegistrationParams* m) {
 namespace {
 
 template <typename T>
-std::vector<T> values_from_bytes(const std::string& bytes, const std::string& what) {
-  static_assert(std::endian::native == std::endian::little, "pair clouds are little-endian float32");
-  if (bytes.size() % sizeof(T) != 0) fail(ErrorCode::kInvalidArgument, what + ": not a whole number of values");
-  std::vector<T> values(bytes.size() / sizeof(T));
-  if (!values.empty()) std::memcpy(static_cast<void*>(values.data()), bytes.data(), bytes.size());
-  return values;
-}
-
-template <typename T>
 std::string bytes_of(const std::vector<T>& values) {
   return std::string(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
 }
@@ -217,8 +209,8 @@ void cloud_to_proto(const PointCloud& cloud, const std::string& name, v1::PairCl
 PointCloud cloud_from_proto(const v1::PairCloud& m, std::size_t max_points) {
   const std::string name = m.name().empty() ? "pair cloud" : m.name();
   PointCloud cloud;
-  cloud.points = values_from_bytes<Eigen::Vector3f>(m.points_xyz(), name + " points_xyz");
-  cloud.intensity = values_from_bytes<float>(m.intensity(), name + " intensity");
+  cloud.points = api::vectors_from_bytes(m.points_xyz(), name + " points_xyz");
+  cloud.intensity = api::floats_from_bytes(m.intensity(), name + " intensity");
   if (!cloud.intensity.empty() && cloud.intensity.size() != cloud.points.size())
     fail(ErrorCode::kInvalidArgument, name + ": intensity must be empty or one value per point");
   if (max_points > 0 && cloud.points.size() > max_points)
@@ -230,51 +222,6 @@ PointCloud cloud_from_proto(const v1::PairCloud& m, std::size_t max_points) {
   for (const Eigen::Vector3f& p : cloud.points)
     if (!p.allFinite()) fail(ErrorCode::kInvalidArgument, name + ": a point is NaN or infinite");
   return cloud;
-}
-
-Eigen::Matrix4d matrix_from_proto(const google::protobuf::RepeatedField<double>& values) {
-  if (values.size() != 16) fail(ErrorCode::kInvalidArgument, "a transform must have 16 numbers");
-  Eigen::Matrix4d m;
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) m(r, c) = values[4 * r + c];
-  return m;
-}
-
-RegistrationResult result_from_proto(const v1::RegistrationResult& m) {
-  auto points = [](const google::protobuf::RepeatedField<double>& values) {
-    if (values.size() % 3 != 0) fail(ErrorCode::kInvalidArgument, "point coordinates must come in threes");
-    std::vector<Eigen::Vector3d> out;
-    for (int i = 0; i < values.size(); i += 3) out.emplace_back(values[i], values[i + 1], values[i + 2]);
-    return out;
-  };
-  RegistrationResult r;
-  r.transform = matrix_from_proto(m.transform());
-  r.rmse_m = m.rmse_m();
-  r.overlap = m.overlap();
-  r.inliers = m.inliers();
-  r.source_points = m.source_points();
-  r.target_points = m.target_points();
-  r.source_voxels = m.source_voxels();
-  r.target_voxels = m.target_voxels();
-  r.source_keypoints = m.source_keypoints();
-  r.target_keypoints = m.target_keypoints();
-  r.signal = m.signal();
-  r.ambiguity_margin = m.ambiguity_margin();
-  r.ambiguous = m.ambiguous();
-  r.ambiguity_reason = m.ambiguity_reason();
-  r.well_supported = m.well_supported();
-  r.min_scale_m_used = m.min_scale_m_used();
-  r.overlap_used = m.overlap_used();
-  for (const v1::Hypothesis& h : m.hypotheses())
-    r.hypotheses.push_back({matrix_from_proto(h.transform()), h.keypoint_score(), h.cloud_score(), h.refined_score(),
-                            h.surface_agreement(), points(h.base_source_m()), points(h.base_target_m())});
-  if (r.hypotheses.empty()) fail(ErrorCode::kInvalidArgument, "a result without hypotheses");
-  r.bases_tried = m.bases_tried();
-  r.seed = m.seed();
-  r.icp_converged = m.icp_converged();
-  r.icp_iterations = m.icp_iterations();
-  for (const v1::StageTiming& t : m.timings()) r.timings.push_back({t.stage(), t.seconds()});
-  return r;
 }
 
 }  // namespace k4reg::service

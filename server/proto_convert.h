@@ -28,11 +28,6 @@ void params_to_proto(const RegistrationParams& params, v1::RegistrationParams* m
 void cloud_to_proto(const PointCloud& cloud, const std::string& name, v1::PairCloud* message);
 PointCloud cloud_from_proto(const v1::PairCloud& message, std::size_t max_points);
 
-// A peer's result back into the core's struct (RegisterPair). Throws k4reg::Error(kInvalidArgument) for a
-// malformed one.
-RegistrationResult result_from_proto(const v1::RegistrationResult& message);
-Eigen::Matrix4d matrix_from_proto(const google::protobuf::RepeatedField<double>& values);
-
 // Row-major 4x4 -> 16 repeated doubles.
 void matrix_to_proto(const Eigen::Matrix4d& matrix, google::protobuf::RepeatedField<double>* values);
 

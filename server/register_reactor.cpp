@@ -14,6 +14,7 @@ RegisterReactor::RegisterReactor(ServiceContext& service, grpc::CallbackServerCo
     return;
   }
   try {
+    service_.check_inline_size(request->ByteSizeLong());
     params_ = params_from_proto(request->params());
     preview_points_ = preview_points_from_proto(request->preview_points());
     source_ = service_.cloud_source(request->source(), "source");

@@ -82,6 +82,12 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
       ->envname("K4REG_MAX_INLINE_MB")
       ->capture_default_str()
       ->check(CLI::Range(1, 1024));
+  app.add_option("--max-pair-mb", c.max_pair_mb,
+                 "largest pair job a peer sends (RegisterPair: two clouds inline, 16 B per point), MiB; the same on "
+                 "every replica: a coordinator registers larger pairs itself")
+      ->envname("K4REG_MAX_PAIR_MB")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 2000.0));
   app.add_option("--max-connection-age-s", c.max_connection_age_s,
                  "close connections after about this long so clients rebalance across replicas, 0 = never")
       ->envname("K4REG_MAX_CONNECTION_AGE_S")
@@ -134,6 +140,7 @@ nlohmann::json config_to_json(const ServerConfig& c) {
           {"pair_workers", c.pair_workers},
           {"pair_queue_size", c.pair_queue_size},
           {"peer_in_flight", c.peer_in_flight},
+          {"max_pair_mb", c.max_pair_mb},
           {"job_threads", c.job_threads},
           {"max_points", c.max_points},
           {"memory_budget_mb", c.memory_budget_mb},

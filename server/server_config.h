@@ -32,7 +32,8 @@ struct ServerConfig {
   std::string tls_client_ca;                  // PEM CA file: clients must present a certificate it signed
   std::string health_listen;                  // plaintext health-only listener; "" = none
   std::size_t max_upload_mb = 4096;           // per streamed file
-  std::size_t max_inline_mb = 32;             // per unary request (inline clouds), gRPC message limit
+  std::size_t max_inline_mb = 32;             // per Register / RegisterProject request (inline clouds)
+  double max_pair_mb = 1024;                  // per RegisterPair request (a peer's pair job); gRPC's message limit
   double max_connection_age_s = 0;            // 0 = unlimited; otherwise GOAWAY after ~this long (rebalancing)
   double max_connection_age_grace_s = 600;    // calls in flight on an aged connection get this long to end
   double keepalive_time_s = 60;               // server pings idle connections this often

@@ -1,5 +1,7 @@
 #include "service_context.h"
 
+#include <fmt/format.h>
+
 #include "auth.h"
 #include "k4reg/util/error.h"
 #include "proto_convert.h"
@@ -71,6 +73,13 @@ grpc::Status ServiceContext::submit_pair(std::shared_ptr<Job> job, std::size_t& 
 }
 
 bool ServiceContext::withdraw_pair(const Job* job) const { return withdraw_from(pair_queue, metrics, job); }
+
+void ServiceContext::check_inline_size(std::size_t bytes) const {
+  if (bytes > max_inline_bytes)
+    fail(ErrorCode::kResourceExhausted, fmt::format("a request of {:.1f} MiB, more than {} MiB (--max-inline-mb): upload "
+                                                    "large clouds with RegisterStream or reference them by path",
+                                                    double(bytes) / (1 << 20), max_inline_bytes >> 20));
+}
 
 CloudSource ServiceContext::referenced_cloud(const std::string& path) const { return {path, paths.resolve(path), {}}; }
 

@@ -15,6 +15,7 @@
 #include "memory_budget.h"
 #include "metrics.h"
 #include "path_policy.h"
+#include "peer_pair_runner.h"
 #include "registration_job.h"
 #include "request_log.h"
 #include "spool.h"
@@ -48,7 +49,10 @@ struct ServiceContext {
   bool withdraw_pair(const Job* job) const;
   // k4reg-server --peers: where project pairs go (null = in process), and how.
   std::shared_ptr<grpc::Channel> peers;
-  int peer_in_flight = 4;
+  PeerOptions peer_options;
+  // Throws k4reg::Error(kResourceExhausted) for a Register or RegisterProject request over --max-inline-mb
+  // (gRPC's own message limit is the larger --max-pair-mb, for RegisterPair).
+  void check_inline_size(std::size_t bytes) const;
   // A file reference as the worker will read it (throws k4reg::Error, see PathPolicy::resolve).
   CloudSource referenced_cloud(const std::string& path) const;
   // A RegisterRequest's cloud: a reference or inline bytes (which the request owns). Throws k4reg::Error.

@@ -156,7 +156,8 @@ TEST_F(Errors, UploadProtocolViolationsAreInvalidArgument) {
 class Budgets : public Errors {
  protected:
   // bun045 has 40097 points, bun000 40256; two clouds of 40097 need 4.8 MB at 60 bytes per point.
-  Budgets() : Errors({"--max-points", "40100", "--memory-budget-mb", "4", "--max-upload-mb", "1"}) {}
+  Budgets()
+      : Errors({"--max-points", "40100", "--memory-budget-mb", "4", "--max-upload-mb", "1", "--max-inline-mb", "1"}) {}
 };
 
 TEST_F(Budgets, OverTheLimitsIsResourceExhaustedNamingTheLimit) {
@@ -165,6 +166,28 @@ TEST_F(Budgets, OverTheLimitsIsResourceExhaustedNamingTheLimit) {
   const std::string big((3 << 20) / 2, 'x');  // refused by its declared size, before any byte is spooled
   EXPECT_TRUE(has_status(stream(upload_header("a.ply", big, "b.ply", big, quick_params()), {big, big}),
                          grpc::StatusCode::RESOURCE_EXHAUSTED, "--max-upload-mb"));
+  // Inline requests over --max-inline-mb (gRPC's own limit is the larger --max-pair-mb, for peers' pair jobs).
+  {
+    v1::RegisterRequest request = bunny_request(quick_params());
+    request.mutable_source()->mutable_inline_cloud()->set_data(big);
+    request.mutable_source()->mutable_inline_cloud()->set_file_name("big.xyz");
+    grpc::ClientContext context;
+    v1::RegisterResponse reply;
+    EXPECT_TRUE(has_status(stub_->Register(&context, request, &reply), grpc::StatusCode::RESOURCE_EXHAUSTED,
+                           "--max-inline-mb"));
+  }
+  {
+    v1::RegisterProjectRequest request;
+    for (int i = 0; i < 2; ++i) {
+      request.add_scans()->mutable_inline_cloud()->set_data(big);
+      request.mutable_scans(i)->mutable_inline_cloud()->set_file_name("big.xyz");
+    }
+    grpc::ClientContext context;
+    auto reader = stub_->RegisterProject(&context, request);
+    for (v1::RegisterProjectEvent event; reader->Read(&event);) {
+    }
+    EXPECT_TRUE(has_status(reader->Finish(), grpc::StatusCode::RESOURCE_EXHAUSTED, "--max-inline-mb"));
+  }
 }
 
 class Auth : public Errors {

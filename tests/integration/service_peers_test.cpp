@@ -1,9 +1,17 @@
 // Projects fanned out across replicas (k4reg-server --peers): three local replicas on loopback. A project through
-// the coordinator has the single-replica poses bit for bit and says where its pairs ran; a peer killed with SIGKILL
-// mid-project loses nothing; a peer whose pair queue is full is backpressure, not failure.
+// the coordinator has the single-replica poses bit for bit and says where its pairs ran (response, metrics, the
+// peers' access logs); a peer killed with SIGKILL or drained mid-project loses nothing; a peer whose pair queue is
+// full is backpressure, not failure; replicas coordinating at once serve each other's pairs.
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <csignal>
+#include <sstream>
+#include <thread>
 
 #include "test_support.h"
 
@@ -44,7 +52,10 @@ ProjectCall register_project(const ServerProcess& server, const std::function<vo
 
 std::string peers_of(const std::vector<const ServerProcess*>& peers) {
   std::string target = "ipv4:";
-  for (const ServerProcess* peer : peers) target += (target.size() > 5 ? "," : "") + peer->address();
+  for (std::size_t i = 0; i < peers.size(); ++i) {
+    if (i > 0) target += ',';
+    target += peers[i]->address();
+  }
   return target;
 }
 
@@ -97,6 +108,69 @@ TEST_F(ServicePeers, ThreeReplicasGiveTheSingleReplicaPosesAndSayWhereThePairsRa
   }
 }
 
+// The metric `name`{labels...} summed over its samples whose label text contains `label` (e.g. `code="OK"`).
+double metric_sum(const ServerProcess& server, const std::string& name, const std::string& label = "") {
+  const auto reply = server.http().Get("/metrics");
+  EXPECT_TRUE(reply && reply->status == 200);
+  double sum = 0;
+  std::istringstream lines(reply ? reply->body : "");
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind(name + "{", 0) == 0 && line.find(label) != std::string::npos)
+      sum += std::stod(line.substr(line.rfind(' ') + 1));
+  return sum;
+}
+
+TEST_F(ServicePeers, MetricsCountThePairsSentAndReceivedPerPeer) {
+  ServerProcess b({"--workers", "1"});
+  ServerProcess a({"--data-root", bunny_dir().string(), "--workers", "1", "--peers", peers_of({&b})});
+  const ProjectCall call = register_project(a);
+  ASSERT_TRUE(call.status.ok()) << call.status.error_message();
+  EXPECT_EQ(metric_sum(a, "k4reg_peer_pairs_sent_total", "peer=\"ipv4:" + b.address() + "\""), 6);
+  EXPECT_EQ(metric_sum(b, "k4reg_pair_jobs_received_total", "code=\"OK\""), 6);
+  EXPECT_EQ(metric_sum(a, "k4reg_peer_pairs_failed_total"), 0);
+  EXPECT_EQ(metric_sum(b, "k4reg_peer_pairs_sent_total"), 0) << "b coordinated nothing";
+}
+
+// A port no one listens on now (the kernel's pick, released): for a replica that must name itself as its peer.
+int unused_port() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof address;
+  EXPECT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&address), length), 0);
+  EXPECT_EQ(::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length), 0);
+  ::close(fd);
+  return ntohs(address.sin_port);
+}
+
+TEST_F(ServicePeers, ProjectsCoordinatedAtOnceDoNotWaitOnEachOther) {
+  // One replica that is its own peer, both workers holding a project: the pairs run on the pair pool. Were they
+  // jobs of the main pool, each project would wait for pairs no worker is free to run.
+  const std::string address = "127.0.0.1:" + std::to_string(unused_port());
+  ServerProcess a({"--grpc-listen", address, "--data-root", bunny_dir().string(), "--workers", "2", "--pair-workers",
+                   "1", "--peers", "ipv4:" + address});
+  ProjectCall first, second;
+  std::thread other([&] { second = register_project(a); });
+  first = register_project(a);
+  other.join();
+  for (const ProjectCall* call : {&first, &second}) {
+    ASSERT_TRUE(call->status.ok()) << call->status.error_message();
+    expect_same_poses(call->response.result(), *reference_);
+    EXPECT_EQ(call->response.pairs_on_peers(), 6u);
+  }
+}
+
+TEST_F(ServicePeers, APeerDrainedMidProjectLosesNothing) {
+  ServerProcess b({"--workers", "1", "--drain-grace-s", "30"}), c({"--workers", "1"});
+  ServerProcess a({"--data-root", bunny_dir().string(), "--workers", "1", "--peers", peers_of({&b, &c})});
+  const ProjectCall call = register_project(a, [&] { b.signal(SIGTERM); });
+  ASSERT_TRUE(call.status.ok()) << call.status.error_message();
+  expect_same_poses(call.response.result(), *reference_);
+  EXPECT_EQ(call.response.pairs_on_peers() + call.response.pairs_local(), 6u);
+  EXPECT_EQ(b.wait(), 0) << "the drained peer finished its pairs and exited cleanly";
+}
+
 TEST_F(ServicePeers, APeerKilledMidProjectLosesNothing) {
   ServerProcess b({"--workers", "1"}), c({"--workers", "1"});
   ServerProcess a({"--data-root", bunny_dir().string(), "--workers", "1", "--peers", peers_of({&b, &c})});
@@ -115,6 +189,17 @@ TEST_F(ServicePeers, AFullPairQueueIsBackpressureNotFailure) {
   expect_same_poses(call.response.result(), *reference_);
   EXPECT_EQ(call.response.pairs_on_peers(), 6u) << "every pair waited for the peer rather than running locally";
   EXPECT_GT(call.response.pair_retries(), 0u);
+}
+
+TEST_F(ServicePeers, PairsLargerThanAPeerAcceptsRunOnTheCoordinator) {
+  ServerProcess b({"--workers", "1", "--max-pair-mb", "0.5"});
+  ServerProcess a({"--data-root", bunny_dir().string(), "--workers", "1", "--peers", peers_of({&b}), "--max-pair-mb",
+                   "0.5"});
+  const ProjectCall call = register_project(a);
+  ASSERT_TRUE(call.status.ok()) << call.status.error_message();
+  expect_same_poses(call.response.result(), *reference_);
+  EXPECT_EQ(call.response.pairs_local(), 6u) << "a pair of bunny scans is about 0.9 MiB";
+  EXPECT_EQ(metric_sum(a, "k4reg_peer_pairs_failed_total", "reason=\"too_large\""), 6);
 }
 
 TEST_F(ServicePeers, NoPeerAnsweringRunsThePairsLocally) {

@@ -87,8 +87,10 @@ ExecVectors exec_vectors(std::vector<std::string> arguments, const std::map<std:
 ServerProcess::ServerProcess(const std::vector<std::string>& args, const std::map<std::string, std::string>& env) {
   const fs::path port_file = work_.path() / "port", http_port_file = work_.path() / "http_port",
                  log_file = work_.path() / "server.log";
-  std::vector<std::string> arguments{K4REG_BIN_DIR "/k4reg-server", "--grpc-listen", "127.0.0.1:0",
-                                     "--port-file", port_file.string(), "--spool-dir", (work_.path() / "spool").string()};
+  std::vector<std::string> arguments{K4REG_BIN_DIR "/k4reg-server", "--port-file", port_file.string(), "--spool-dir",
+                                     (work_.path() / "spool").string()};
+  if (std::find(args.begin(), args.end(), "--grpc-listen") == args.end())
+    arguments.insert(arguments.end(), {"--grpc-listen", "127.0.0.1:0"});
   const bool own_http = std::find(args.begin(), args.end(), "--http-listen") != args.end();
   if (!own_http)
     arguments.insert(arguments.end(), {"--http-listen", "127.0.0.1:0", "--http-port-file", http_port_file.string()});

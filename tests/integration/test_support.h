@@ -58,7 +58,7 @@ class TempDir {
 };
 
 // The real binary, started with `args` plus --grpc-listen and --http-listen on 127.0.0.1:0 (never a fixed
-// port, so ctest -j works; --http-listen only unless `args` has its own), their port files and a private
+// port, so ctest -j works; each unless `args` has its own), their port files and a private
 // --spool-dir; stderr (the JSON log) goes to a file. Killed if still running when destroyed.
 class ServerProcess {
  public:
