@@ -10,6 +10,7 @@ configurations the container files define, by tests/integration/docker_entrypoin
 
 import argparse
 import functools
+import math
 import os
 import re
 import shlex
@@ -469,10 +470,13 @@ def check_kubernetes(d, problems):
                         f"K4REG_WORKERS x K4REG_JOB_THREADS = {workers * job_threads} threads on {cores:g} cores")
         budget = int(values.get("K4REG_MEMORY_BUDGET_MB") or 0)
         inline = int(values["K4REG_MAX_INLINE_MB"]) * (workers + int(values["K4REG_QUEUE_SIZE"]))
-        needed = budget + inline + PROCESS_OVERHEAD_MIB
+        # Peers' pair jobs are held in memory while they wait and run, beside the budget their registration uses.
+        pair_workers = int(values.get("K4REG_PAIR_WORKERS") or 0) or workers
+        pairs = math.ceil(float(values["K4REG_MAX_PAIR_MB"]) * (pair_workers + int(values["K4REG_PAIR_QUEUE_SIZE"])))
+        needed = budget + inline + pairs + PROCESS_OVERHEAD_MIB
         problems.expect(0 < budget and needed <= quantity(limits["memory"]), where,
-                        f"memory limit {limits['memory']} < budget {budget} + inline requests {inline} + process "
-                        f"{PROCESS_OVERHEAD_MIB} MiB")
+                        f"memory limit {limits['memory']} < budget {budget} + inline requests {inline} + pair jobs "
+                        f"{pairs} + process {PROCESS_OVERHEAD_MIB} MiB")
 
     security = {**pod["spec"].get("securityContext", {}), **container.get("securityContext", {})}
     problems.expect(security.get("runAsNonRoot") is True, where, "runAsNonRoot must be true")

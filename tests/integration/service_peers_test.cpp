@@ -115,7 +115,7 @@ double metric_sum(const ServerProcess& server, const std::string& name, const st
   double sum = 0;
   std::istringstream lines(reply ? reply->body : "");
   for (std::string line; std::getline(lines, line);)
-    if (line.rfind(name + "{", 0) == 0 && line.find(label) != std::string::npos)
+    if ((line.rfind(name + "{", 0) == 0 || line.rfind(name + " ", 0) == 0) && line.find(label) != std::string::npos)
       sum += std::stod(line.substr(line.rfind(' ') + 1));
   return sum;
 }
@@ -169,6 +169,30 @@ TEST_F(ServicePeers, APeerDrainedMidProjectLosesNothing) {
   expect_same_poses(call.response.result(), *reference_);
   EXPECT_EQ(call.response.pairs_on_peers() + call.response.pairs_local(), 6u);
   EXPECT_EQ(b.wait(), 0) << "the drained peer finished its pairs and exited cleanly";
+}
+
+TEST_F(ServicePeers, TheProjectsDeadlineCancelsItsOutstandingPairCalls) {
+  ServerProcess b({"--workers", "1", "--pair-workers", "1"});
+  ServerProcess a({"--data-root", bunny_dir().string(), "--workers", "1", "--peers", peers_of({&b})});
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(1500));
+  auto reader = a.stub()->RegisterProject(&context, project_request());
+  for (v1::RegisterProjectEvent event; reader->Read(&event);) {
+  }
+  EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+  // Four pairs were out (--peer-in-flight 4) and b runs one at a time: the rest end cancelled, none runs on.
+  int cancelled = 0;
+  double pending = -1;
+  for (int wait = 0; wait < 100 && (cancelled == 0 || pending != 0); ++wait) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    cancelled = 0;
+    for (const nlohmann::json& line : b.log_lines("request"))
+      if (line.value("method", "") == "/k4reg.v1.Registration/RegisterPair" && line.value("code", "") == "CANCELLED")
+        ++cancelled;
+    pending = metric_sum(b, "k4reg_pair_queue_depth") + metric_sum(b, "k4reg_pair_workers_busy");
+  }
+  EXPECT_GT(cancelled, 0);
+  EXPECT_EQ(pending, 0) << "pair jobs still queued or running on the peer";
 }
 
 TEST_F(ServicePeers, APeerKilledMidProjectLosesNothing) {

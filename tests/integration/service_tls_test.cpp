@@ -14,6 +14,7 @@ namespace {
 struct Certificates {
   TempDir dir;
   fs::path ca, server_cert, server_key, client_cert, client_key, stranger_cert, stranger_key;
+  fs::path replica_cert, replica_key;  // server and client: replicas that send each other pair jobs
 };
 
 void openssl(const std::vector<std::string>& arguments) {
@@ -49,11 +50,13 @@ std::unique_ptr<Certificates> make_certificates() {
     make_ca(d, "stranger-ca");
     make_leaf(d, "server", "ca", "subjectAltName=DNS:localhost,IP:127.0.0.1\nextendedKeyUsage=serverAuth");
     make_leaf(d, "client", "ca", "extendedKeyUsage=clientAuth");
+    make_leaf(d, "replica", "ca", "subjectAltName=DNS:localhost,IP:127.0.0.1\nextendedKeyUsage=serverAuth,clientAuth");
     make_leaf(d, "stranger", "stranger-ca", "extendedKeyUsage=clientAuth");
     c->ca = d / "ca.pem";
     c->server_cert = d / "server.pem", c->server_key = d / "server.key";
     c->client_cert = d / "client.pem", c->client_key = d / "client.key";
     c->stranger_cert = d / "stranger.pem", c->stranger_key = d / "stranger.key";
+    c->replica_cert = d / "replica.pem", c->replica_key = d / "replica.key";
   }
   return c;
 }
@@ -162,6 +165,31 @@ TEST(ServiceTls, RefusesToStartWithABadKeyOrCertificate) {
     EXPECT_NE(run.err.find(bad.message), std::string::npos) << run.err;
     EXPECT_EQ(run.err.find("\"serving\""), std::string::npos) << run.err;
   }
+}
+
+TEST(ServiceTls, ReplicasSendPairJobsToEachOtherOverMutualTls) {
+  const auto certificates = make_certificates();
+  const Certificates& c = *certificates;
+  const std::vector<std::string> replica{"--tls-cert", c.replica_cert.string(), "--tls-key", c.replica_key.string(),
+                                         "--tls-client-ca", c.ca.string(), "--data-root", bunny_dir().string()};
+  ServerProcess peer(replica);
+  std::vector<std::string> coordinator = replica;
+  coordinator.insert(coordinator.end(), {"--peers", "ipv4:" + peer.address()});
+  ServerProcess server(coordinator);
+  v1::RegisterProjectRequest request;
+  for (const char* scan : {"bun000.ply", "bun045.ply", "bun090.ply"}) request.add_scans()->set_path(scan);
+  request.mutable_params()->mutable_pairwise()->set_min_scale_m(0.002);
+  request.mutable_params()->mutable_pairwise()->set_overlap(0.5);
+  auto stub = v1::Registration::NewStub(tls_channel(server, c, c.client_cert, c.client_key));
+  grpc::ClientContext context;
+  auto reader = stub->RegisterProject(&context, request);
+  v1::RegisterProjectResponse response;
+  for (v1::RegisterProjectEvent event; reader->Read(&event);)
+    if (event.has_result()) response = event.result();
+  const grpc::Status status = reader->Finish();
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(response.pairs_on_peers(), 3u) << "the peer took the coordinator's certificate";
+  EXPECT_EQ(response.pairs_local(), 0u);
 }
 
 TEST(HealthListener, AnswersHealthOnlyAndInPlaintextWithTlsOn) {
