@@ -63,6 +63,7 @@ nlohmann::json project_to_json(const ProjectResult& r, const std::vector<ScanOri
                  {"overlap", params.pairwise.overlap},
                  {"reference", params.reference},
                  {"pairs", pairs[static_cast<int>(params.pairs)]},
+                 {"levelled", params.pairwise.levelled},
                  {"seed", params.pairwise.seed}};
   return j;
 }

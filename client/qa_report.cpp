@@ -41,6 +41,7 @@ nlohmann::json params_to_json(const RegistrationParams& p) {
           {"max_bases", p.max_bases},
           {"hypotheses_kept", p.hypotheses_kept},
           {"free_space", free_space[static_cast<int>(p.free_space)]},
+          {"levelled", p.levelled},
           {"icp", p.icp},
           {"icp_max_iterations", p.icp_max_iterations},
           {"seed", p.seed},

@@ -18,6 +18,9 @@ RegistrationFlags add_registration_flags(CLI::App& command, RegistrationParams& 
                                   "0.8, then 0.6, then 0.4 until a pose is well supported)")
                       ->check(CLI::Range(0.05, 1.0));
   flags.no_icp = command.add_flag("--no-icp{false}", params.icp, "skip the ICP refinement (coarse K-4PCS result only)");
+  flags.levelled = command.add_flag("--levelled", params.levelled,
+                                    "the scanners were levelled (z axes vertical, as a tilt compensator makes them): "
+                                    "only rotations about z are searched and refined");
   flags.seed = command.add_option("--seed", params.seed, "random seed; the same seed gives the same result")
                    ->capture_default_str();
   flags.threads = command.add_option("--threads", params.threads, "worker threads, 0 = all cores")

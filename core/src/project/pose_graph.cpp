@@ -76,9 +76,9 @@ PoseGraphResult optimize_pose_graph(const std::vector<Eigen::Matrix4d>& initial,
       const Vector6d r = residual(out.poses[link.from], out.poses[link.to], link);
       const double w = link.weight * huber_weight(r.norm(), params.huber_m);
       // Central differences with respect to each end's perturbation.
-      Matrix6d jacobian[2];
+      Matrix6d jacobian[2] = {Matrix6d::Zero(), Matrix6d::Zero()};
       for (int end = 0; end < 2; ++end)
-        for (int k = 0; k < 6; ++k) {
+        for (int k = params.levelled ? 2 : 0; k < 6; ++k) {  // levelled: no rotation about x or y
           Vector6d d = Vector6d::Zero();
           d(k) = kStep;
           const std::size_t s = end == 0 ? link.from : link.to;

@@ -290,6 +290,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     for (const ProjectScan& scan : r.scans) poses.push_back(scan.pose);
     PoseGraphParams solver;
     solver.fixed = r.reference;
+    solver.levelled = params.pairwise.levelled;
     if (!tolerances.empty()) {
       std::vector<double> sorted = tolerances;
       std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());

@@ -170,7 +170,7 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
         for (std::size_t s = 0; s < sets.size(); ++s) {
           if ((s & 255) == 0) check(cancel);
           for (int k = 0; k < 4; ++k) to.col(k) = target[sets[s][k]].cast<double>();
-          const Eigen::Matrix4d t = fit_rigid(from, to);
+          const Eigen::Matrix4d t = params.levelled ? fit_rigid_about_z(from, to) : fit_rigid(from, to);
           if (fit_rms(t, from, to) > tolerance.fit_rms_m) continue;
           const double beat = std::max(out.floor(), global_best);
           // Prescreens on the first points: a hypothesis far below the best so far is not worth a full look.

@@ -64,6 +64,16 @@ Accumulation accumulate(const std::vector<Eigen::Vector3f>& source, const std::v
       [](Accumulation a, const Accumulation& b) { return a += b; });
 }
 
+// The Gauss-Newton step [rotation; translation]; levelled: the rotation about x and y stays zero (the 4 x 4
+// system of the other unknowns).
+Eigen::Matrix<double, 6, 1> solve_step(const Accumulation& acc, bool levelled) {
+  if (!levelled) return acc.hessian.ldlt().solve(-acc.gradient);
+  const Eigen::Matrix4d hessian = acc.hessian.bottomRightCorner<4, 4>();
+  Eigen::Matrix<double, 6, 1> delta = Eigen::Matrix<double, 6, 1>::Zero();
+  delta.tail<4>() = hessian.ldlt().solve(-acc.gradient.tail<4>());
+  return delta;
+}
+
 }  // namespace
 
 std::vector<Eigen::Vector3f> estimate_normals(const std::vector<Eigen::Vector3f>& points, const NeighborGrid& grid,
@@ -126,7 +136,7 @@ IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const E
           accumulate(src.points, tgt.points, tgt.normals, *tgt.grid, to_affine3f(result.transform), max_distance, voxel);
       ++result.iterations;
       if (acc.inliers < 6) break;
-      const Eigen::Matrix<double, 6, 1> delta = acc.hessian.ldlt().solve(-acc.gradient);
+      const Eigen::Matrix<double, 6, 1> delta = solve_step(acc, params.levelled);
       if (!delta.allFinite()) break;
       Eigen::Matrix4d step = Eigen::Matrix4d::Identity();
       const double angle = delta.head<3>().norm();

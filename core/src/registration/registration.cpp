@@ -208,6 +208,7 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
   IcpParams icp_params;
   icp_params.voxel_m = sigma;
   icp_params.max_iterations = params.icp_max_iterations;
+  icp_params.levelled = params.levelled;
   std::optional<std::pair<IcpPyramid, IcpPyramid>> pyramids;  // source, target
   auto icp_pyramids = [&]() -> const std::pair<IcpPyramid, IcpPyramid>& {
     if (!pyramids)
@@ -281,6 +282,7 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
     // 3. 4PCS on the two point sets (paper Sec. 2.2).
     const FourPcsResult matched = timer.run("matching", [&] {
       FourPcsParams four{delta, overlap, params.max_bases, params.hypotheses_kept, seed};
+      four.levelled = params.levelled;
       if (!plain) four.source_labels = &sets.source_labels, four.target_labels = &sets.target_labels;
       return match_4pcs(sets.source, sets.target, four, cancel, progress);
     });
@@ -290,7 +292,8 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
     //    voxelised clouds, where the furniture that breaks a room's symmetry is visible.
     const auto& icp = icp_pyramids();
     out.guarded = timer.run("symmetry_guard", [&] {
-      return rank_hypotheses(icp.first, icp.second, matched.hypotheses, overlap, free_space ? &views : nullptr, cancel);
+      return rank_hypotheses(icp.first, icp.second, matched.hypotheses, overlap, free_space ? &views : nullptr,
+                             params.levelled, cancel);
     });
     return out;
   };

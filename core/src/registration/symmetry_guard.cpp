@@ -63,9 +63,9 @@ Eigen::Matrix3d normal_axes(const std::vector<Eigen::Vector3f>& normals) {
 // Half-turns about the columns of `axes` through `centre`: a rectangular room's shell looks the same
 // after a half turn about the vertical (and nearly so about the other two axes), so a pose composed with
 // one of them is where 4PCS's symmetric twin of the true pose lies. As target -> target maps.
-std::vector<Eigen::Matrix4d> half_turns(const Eigen::Matrix3d& axes, const Eigen::Vector3d& centre) {
+std::vector<Eigen::Matrix4d> half_turns(const Eigen::Matrix3Xd& axes, const Eigen::Vector3d& centre) {
   std::vector<Eigen::Matrix4d> turns;
-  for (int axis = 0; axis < 3; ++axis) {
+  for (Eigen::Index axis = 0; axis < axes.cols(); ++axis) {
     const Eigen::Matrix3d r = Eigen::AngleAxisd(M_PI, axes.col(axis).normalized()).toRotationMatrix();
     Eigen::Matrix4d s = Eigen::Matrix4d::Identity();
     s.topLeftCorner<3, 3>() = r;
@@ -149,7 +149,7 @@ double cloud_score(const std::vector<Eigen::Vector3f>& source, const IcpPyramid:
 
 SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& target,
                                     std::vector<Hypothesis> hypotheses, double overlap, const ScanViews* views,
-                                    const CancellationToken* cancel) {
+                                    bool levelled, const CancellationToken* cancel) {
   constexpr int kStages = 2, kIterations = 6;  // settle, don't polish: the final ICP does that
   constexpr std::size_t kSettlePoints = 4000;
   const IcpPyramid settling_source = thinned(source, kSettlePoints);
@@ -161,6 +161,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   IcpParams quick;
   quick.stages = kStages;
   quick.max_iterations = kIterations;
+  quick.levelled = levelled;
   // A hypothesis can be a metre or two off where it matters, beyond the guard's ICP stages: a 4PCS fit on
   // keypoints a few metres apart tilts a wide outdoor scene by degrees, and a twin's estimated centre is
   // rough. Two wider stages (2 and 4 times the pyramid's coarsest spacing, a few thousand points) reach
@@ -170,6 +171,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   wide.voxel_m = 2.0 * source.stages.front().voxel_m;
   wide.stages = 2;
   wide.max_iterations = 10;
+  wide.levelled = levelled;
   const IcpPyramid wide_source = thinned(make_icp_pyramid(source.stages.front().points, wide, false, cancel), kSettlePoints);
   const IcpPyramid wide_target = make_icp_pyramid(target.stages.front().points, wide, true, cancel);
   auto settle = [&](Hypothesis& h) {
@@ -212,9 +214,12 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
       h.transform = transform;
       return h;
     };
-    for (const Eigen::Matrix4d& s : half_turns(point_axes(coarse_target.points, centre), centre))
-      twins.push_back(twin(s * best));
-    for (const Eigen::Matrix4d& s : half_turns(normal_axes(coarse_target.normals), centre)) {
+    // Levelled scans have one symmetry axis to try: the vertical.
+    const auto axes = [&](const Eigen::Matrix3d& principal) {
+      return levelled ? half_turns(Eigen::Vector3d::UnitZ(), centre) : half_turns(principal, centre);
+    };
+    for (const Eigen::Matrix4d& s : axes(point_axes(coarse_target.points, centre))) twins.push_back(twin(s * best));
+    for (const Eigen::Matrix4d& s : axes(normal_axes(coarse_target.normals))) {
       Eigen::Matrix4d turned = s * best;
       for (const Eigen::Vector3d& shift : vote_translations(voting_source, voting_target, turned.topLeftCorner<3, 3>(),
                                                             2.0 * coarse_target.voxel_m, kShifts)) {

@@ -25,6 +25,7 @@ struct PoseGraphParams {
   std::size_t fixed = 0;       // the scan whose pose stays as given (the project's reference)
   double huber_m = 0.0;        // residuals beyond this many metres are down-weighted; 0 = plain least squares
   int max_iterations = 100;
+  bool levelled = false;       // poses change by rotations about the project's z axis only (levelled scanners)
 };
 
 struct PoseGraphResult {

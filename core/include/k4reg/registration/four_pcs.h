@@ -20,6 +20,9 @@ struct FourPcsParams {
   int hypotheses_kept = 5;
   std::uint64_t seed = 42;
   int verification_points = 1000;  // source points scored per hypothesis
+  // Levelled scanners (z axes vertical): every fit is a rotation about z and a translation, so a congruent set
+  // that would need a tilt fails the fit tolerance (no out-of-plane flips, fewer sets verified).
+  bool levelled = false;
   // Optional, one per point: a congruent set counts only where each target point carries the label of the
   // base point it stands for. The pipeline labels keypoints by their DoG extremum's sign (a bright blob
   // can only be a bright blob in the other scan), which removes most chance sets before verification.

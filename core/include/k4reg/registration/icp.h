@@ -18,6 +18,7 @@ struct IcpParams {
   int stages = 3;                    // spacings voxel_m * 2^(stages-1) ... voxel_m
   int max_iterations = 50;           // per stage
   double max_distance_factor = 2.5;  // correspondences within this many stage voxels
+  bool levelled = false;             // only rotations about z (and translations): 4 unknowns, not 6
 };
 
 struct IcpResult {

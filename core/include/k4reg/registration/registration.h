@@ -57,6 +57,11 @@ struct RegistrationParams {
   // saw empty space: breaks the 180-degree flips of symmetric rooms.
   FreeSpaceCheck free_space = FreeSpaceCheck::kAuto;
 
+  // Levelled scanners (a tilt compensator makes their z axes vertical): only rotations about z are searched and
+  // refined, so no out-of-plane flip can win, and fewer 4PCS sets pass the fit. Every transform is then a
+  // rotation about z and a translation. Wrong for tilted scans (a handheld or mobile scanner).
+  bool levelled = false;
+
   // ICP refinement.
   bool icp = true;
   int icp_max_iterations = 50;

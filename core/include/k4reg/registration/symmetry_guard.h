@@ -42,9 +42,10 @@ double cloud_score(const std::vector<Eigen::Vector3f>& source, const IcpPyramid:
                    double overlap);
 
 // Uses the two coarsest levels of the ICP pyramids and scores on the second. overlap: the expected share
-// of the source the target sees (the registration's parameter).
+// of the source the target sees (the registration's parameter). levelled: the scanners' z axes are vertical,
+// so hypotheses settle by rotations about z only and the symmetric twins are half-turns about z.
 SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& target,
                                     std::vector<Hypothesis> hypotheses, double overlap, const ScanViews* views,
-                                    const CancellationToken* cancel = nullptr);
+                                    bool levelled = false, const CancellationToken* cancel = nullptr);
 
 }  // namespace k4reg
