@@ -10,6 +10,8 @@
 #include <unistd.h>
 
 #include <array>
+#include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <stdexcept>
 #include <string_view>
@@ -124,6 +126,24 @@ std::string_view reason_phrase(int status) {
   }
 }
 
+// Closing a socket with unread request bytes (a body this listener does not want) resets the connection, and the
+// reset can destroy the answer before the client reads it. So: finish sending, then read what the client still
+// sends, for at most a second and kMaxDrainBytes, and only then close.
+void close_after_answer(int fd) {
+  constexpr std::size_t kMaxDrainBytes = 16 << 20;
+  shutdown(fd, SHUT_WR);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+  const timeval wait{0, 100'000};
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &wait, sizeof wait);
+  std::array<char, 16384> sink;
+  for (std::size_t drained = 0; drained < kMaxDrainBytes && std::chrono::steady_clock::now() < deadline;) {
+    const ssize_t got = recv(fd, sink.data(), sink.size(), 0);
+    if (got == 0 || (got < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)) break;
+    if (got > 0) drained += std::size_t(got);
+  }
+  close(fd);
+}
+
 void send_all(int fd, const std::string& bytes) {
   for (std::size_t sent = 0; sent < bytes.size();) {
     const ssize_t done = send(fd, bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);
@@ -175,7 +195,7 @@ void HealthListener::accept_loop() {
       continue;
     }
     answer_http(connection);
-    close(connection);
+    close_after_answer(connection);
   }
 }
 

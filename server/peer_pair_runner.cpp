@@ -51,11 +51,12 @@ PeerPairRunner::PeerPairRunner(std::shared_ptr<grpc::Channel> peers, const PeerO
                                Metrics& metrics, PairPlacement& placement)
     : peers_(std::move(peers)), options_(options), caller_(std::move(caller)), metrics_(metrics), placement_(placement) {}
 
-void PeerPairRunner::run(const std::vector<PointCloud>& scans, const std::vector<ScanPair>& pairs,
+void PeerPairRunner::run(const std::vector<PreparedScan>& scans, const std::vector<ScanPair>& pairs,
                          const RegistrationParams& params, const CancellationToken* cancel, const Done& done) {
   // Each scan is encoded once, whatever the number of pairs it is in.
   std::vector<v1::PairCloud> clouds(scans.size());
-  for (std::size_t i = 0; i < scans.size(); ++i) cloud_to_proto(scans[i], "scan " + std::to_string(i), &clouds[i]);
+  for (std::size_t i = 0; i < scans.size(); ++i)
+    cloud_to_proto(scans[i].cloud(), "scan " + std::to_string(i), &clouds[i]);
   v1::RegistrationParams sent;
   params_to_proto(params, &sent);
   auto stub = v1::Registration::NewStub(peers_);

@@ -52,7 +52,7 @@ class PeerPairRunner : public PairRunner {
  public:
   PeerPairRunner(std::shared_ptr<grpc::Channel> peers, const PeerOptions& options, PeerCaller caller, Metrics& metrics,
                  PairPlacement& placement);
-  void run(const std::vector<PointCloud>& scans, const std::vector<ScanPair>& pairs, const RegistrationParams& params,
+  void run(const std::vector<PreparedScan>& scans, const std::vector<ScanPair>& pairs, const RegistrationParams& params,
            const CancellationToken* cancel, const Done& done) override;
 
  private:

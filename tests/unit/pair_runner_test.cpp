@@ -18,7 +18,7 @@ const std::string kBunny = std::string(K4REG_TEST_DATA_DIR) + "/bunny/";
 class ReversedConcurrentRunner : public PairRunner {
  public:
   std::size_t failing = SIZE_MAX;  // this pair reports an error instead of registering
-  void run(const std::vector<PointCloud>& scans, const std::vector<ScanPair>& pairs, const RegistrationParams& params,
+  void run(const std::vector<PreparedScan>& scans, const std::vector<ScanPair>& pairs, const RegistrationParams& params,
            const CancellationToken* cancel, const Done& done) override {
     std::vector<PairOutcome> outcomes(pairs.size());
     std::vector<std::thread> threads;
@@ -83,7 +83,38 @@ TEST_F(PairRunnerTest, CancellationStopsTheLocalRunner) {
   CancellationToken cancel;
   cancel.cancel();
   LocalPairRunner runner;
-  EXPECT_THROW(runner.run(scans, {{0, 1}}, params.pairwise, &cancel, [](std::size_t, PairOutcome) {}), Error);
+  const std::vector<PreparedScan> prepared(scans.begin(), scans.end());
+  EXPECT_THROW(runner.run(prepared, {{0, 1}}, params.pairwise, &cancel, [](std::size_t, PairOutcome) {}), Error);
+}
+
+// The local runner, keeping what each pair gave.
+class RecordingRunner : public PairRunner {
+ public:
+  std::vector<std::pair<ScanPair, RegistrationResult>> results;
+  void run(const std::vector<PreparedScan>& scans, const std::vector<ScanPair>& pairs, const RegistrationParams& params,
+           const CancellationToken* cancel, const Done& done) override {
+    LocalPairRunner().run(scans, pairs, params, cancel, [&](std::size_t k, PairOutcome outcome) {
+      if (outcome.result) results.emplace_back(pairs[k], *outcome.result);
+      done(k, std::move(outcome));
+    });
+  }
+};
+
+// Scans prepared once for the project (prepared_scan.h; each is in two of the three pairs, as source and as
+// target) give each pair what register_clouds gives its two clouds alone.
+TEST_F(PairRunnerTest, SharedScanPreparationChangesNoPairByABit) {
+  RecordingRunner runner;
+  register_project(scans, params, nullptr, {}, {}, &runner);
+  ASSERT_EQ(runner.results.size(), 3u);
+  for (const auto& [pair, shared] : runner.results) {
+    const RegistrationResult alone = register_clouds(scans[pair.first], scans[pair.second], params.pairwise);
+    EXPECT_EQ(shared.transform, alone.transform) << pair.first << " -> " << pair.second;
+    EXPECT_EQ(shared.rmse_m, alone.rmse_m);
+    EXPECT_EQ(shared.ambiguity_margin, alone.ambiguity_margin);
+    ASSERT_EQ(shared.hypotheses.size(), alone.hypotheses.size());
+    for (std::size_t h = 0; h < alone.hypotheses.size(); ++h)
+      EXPECT_EQ(shared.hypotheses[h].transform, alone.hypotheses[h].transform);
+  }
 }
 
 }  // namespace

@@ -4,7 +4,7 @@
 
 namespace k4reg {
 
-PairOutcome register_pair(const PointCloud& source, const PointCloud& target, const RegistrationParams& params,
+PairOutcome register_pair(const PreparedScan& source, const PreparedScan& target, const RegistrationParams& params,
                           const CancellationToken* cancel) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
@@ -19,7 +19,7 @@ PairOutcome register_pair(const PointCloud& source, const PointCloud& target, co
   return outcome;
 }
 
-void LocalPairRunner::run(const std::vector<PointCloud>& scans, const std::vector<ScanPair>& pairs,
+void LocalPairRunner::run(const std::vector<PreparedScan>& scans, const std::vector<ScanPair>& pairs,
                           const RegistrationParams& params, const CancellationToken* cancel, const Done& done) {
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     check(cancel);

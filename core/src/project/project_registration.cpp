@@ -176,8 +176,10 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
   const std::vector<ScanPair> pairs = candidate_pairs(scans.size(), params.pairs, params.pair_list);
   std::vector<PairOutcome> outcomes(pairs.size());
   std::size_t pairs_done = 0;
+  // Each scan's voxels, keypoints and pyramids are computed once, in its first pair, and shared by the rest.
+  const std::vector<PreparedScan> prepared(scans.begin(), scans.end());
   LocalPairRunner local;
-  (runner ? *runner : local).run(scans, pairs, pairwise, &budget, [&](std::size_t k, PairOutcome outcome) {
+  (runner ? *runner : local).run(prepared, pairs, pairwise, &budget, [&](std::size_t k, PairOutcome outcome) {
     outcomes.at(k) = std::move(outcome);
     ProjectLink link;
     link_from_outcome(outcomes[k], pairs[k], link);

@@ -109,13 +109,18 @@ IcpPyramid make_icp_pyramid(const std::vector<Eigen::Vector3f>& points, const Ic
     IcpPyramid::Stage& s = pyramid.stages[stage];
     s.voxel_m = params.voxel_m * std::pow(2.0, params.stages - 1 - stage);
     s.points = stage == params.stages - 1 ? points : downsample(points, s.voxel_m);
-    if (as_target) {
-      // One grid serves the correspondences and the normals (both look about 2.5 voxels around).
-      s.grid = std::make_unique<NeighborGrid>(s.points, params.max_distance_factor * s.voxel_m);
-      s.normals = estimate_normals(s.points, *s.grid, 2.5 * s.voxel_m);
-    }
   }
+  if (as_target) add_target_search(pyramid, params, cancel);
   return pyramid;
+}
+
+void add_target_search(IcpPyramid& pyramid, const IcpParams& params, const CancellationToken* cancel) {
+  for (IcpPyramid::Stage& s : pyramid.stages) {
+    check(cancel);
+    // One grid serves the correspondences and the normals (both look about 2.5 voxels around).
+    s.grid = std::make_unique<NeighborGrid>(s.points, params.max_distance_factor * s.voxel_m);
+    s.normals = estimate_normals(s.points, *s.grid, 2.5 * s.voxel_m);
+  }
 }
 
 IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const Eigen::Matrix4d& initial,

@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "k4reg/registration/dog_keypoints.h"
+#include "k4reg/registration/prepared_scan.h"
 #include "k4reg/util/error.h"
 #include "k4reg/registration/four_pcs.h"
 #include "k4reg/registration/free_space.h"
@@ -94,9 +95,6 @@ void check_geometry(const std::vector<Eigen::Vector3f>& points, double scale_m, 
   if (spread(0) < 0.5 * scale_m)
     fail(ErrorCode::kInvalidArgument, std::string(name) + " cloud is degenerate: all points lie on a plane");
 }
-
-// The scanner sits at the file frame's origin, i.e. at -origin_m in the cloud's local frame.
-Eigen::Vector3f scanner_position(const PointCloud& cloud) { return (-cloud.origin_m).cast<float>(); }
 
 // Whether p lies inside the bounding box of the points.
 bool inside_bounds(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& p) {
@@ -182,9 +180,10 @@ struct ScaleAttempt {
 };
 
 // The single-scale pipeline, steps 1-5, at minimum scale sigma.
-ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& target,
-                                     const RegistrationParams& params, double sigma, const CancellationToken* cancel,
-                                     const ProgressCallback& progress) {
+ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedScan& target_scan,
+                               const RegistrationParams& params, double sigma, const CancellationToken* cancel,
+                               const ProgressCallback& progress) {
+  const PointCloud &source = source_scan.cloud(), &target = target_scan.cloud();
   RegistrationResult result;
   result.seed = params.seed;
   result.source_points = source.size();
@@ -196,9 +195,9 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
   // Named references rather than structured bindings: lambdas below use them, and clang < 16 cannot capture
   // a structured binding.
   const auto voxelised = timer.run("voxel_grid", [&] {
-    return std::make_pair(voxel_grid(source, sigma, cancel), voxel_grid(target, sigma, cancel));
+    return std::make_pair(&source_scan.voxels(sigma, cancel), &target_scan.voxels(sigma, cancel));
   });
-  const VoxelizedCloud &source_voxels = voxelised.first, &target_voxels = voxelised.second;
+  const VoxelizedCloud &source_voxels = *voxelised.first, &target_voxels = *voxelised.second;
   result.source_voxels = source_voxels.cloud.size();
   result.target_voxels = target_voxels.cloud.size();
   check_geometry(source_voxels.cloud.points, sigma, "source");
@@ -209,13 +208,14 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
   icp_params.voxel_m = sigma;
   icp_params.max_iterations = params.icp_max_iterations;
   icp_params.levelled = params.levelled;
-  std::optional<std::pair<IcpPyramid, IcpPyramid>> pyramids;  // source, target
-  auto icp_pyramids = [&]() -> const std::pair<IcpPyramid, IcpPyramid>& {
+  using Pyramids = std::pair<const IcpPyramid&, const IcpPyramid&>;  // source, target
+  std::optional<Pyramids> pyramids;
+  auto icp_pyramids = [&]() -> const Pyramids& {
     if (!pyramids)
-      pyramids = timer.run("icp_setup", [&] {
-        return std::make_pair(make_icp_pyramid(source_voxels.cloud.points, icp_params, false, cancel),
-                              make_icp_pyramid(target_voxels.cloud.points, icp_params, true, cancel));
-      });
+      pyramids.emplace(timer.run("icp_setup", [&] {
+        return Pyramids(source_scan.pyramid(sigma, icp_params, false, cancel),
+                        target_scan.pyramid(sigma, icp_params, true, cancel));
+      }));
     return *pyramids;
   };
   // The point precision every 4PCS tolerance derives from. Repeated keypoints of two scans lie within
@@ -226,10 +226,9 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
     return params.plain_voxel_m > 0 ? params.plain_voxel_m : spacing_for_count(source_voxels.cloud, 4 * sigma, 2000);
   });
   result.free_space_used = use_free_space(params.free_space, source_voxels, target_voxels);
-  std::optional<FreeSpaceImage> free_space;
-  if (result.free_space_used)
-    free_space.emplace(target.points, scanner_position(target), 3.0 * delta);  // raw points fill every cell
-  const ScanViews views{free_space ? &*free_space : nullptr, scanner_position(source), scanner_position(target)};
+  // Raw points fill every cell.
+  const FreeSpaceImage* free_space = result.free_space_used ? &target_scan.free_space(3.0 * delta) : nullptr;
+  const ScanViews views{free_space, scanner_position(source), scanner_position(target)};
 
   // 2. The point sets 4PCS runs on: DoG keypoints (K-4PCS) or a coarser voxel grid (plain 4PCS).
   std::deque<PointSets> point_sets;  // one per signal asked for so far (a deque: CoarseAlignment points into it)
@@ -240,16 +239,12 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
     PointSets& sets = point_sets.emplace_back();
     if (!plain) {
       timer.run("keypoints", [&] {
-        DogParams dog{sigma, params.octaves, params.scales_per_octave, params.min_contrast};
-        for (const auto* voxels : {&source_voxels, &target_voxels}) {
-          const SurfaceSignal surface = make_surface_signal(voxels->cloud, sigma, signal, intensity, cancel);
-          sets.signal = surface.name;
-          const bool is_source = voxels == &source_voxels;
-          DogKeypoints keypoints = detect_dog_keypoints(voxels->cloud.points, surface.values, dog, cancel);
-          auto& labels = is_source ? sets.source_labels : sets.target_labels;
-          for (const float response : keypoints.response) labels.push_back(response > 0.0f);
-          (is_source ? sets.source : sets.target) = std::move(keypoints.points);
-        }
+        const DogParams dog{sigma, params.octaves, params.scales_per_octave, params.min_contrast};
+        const ScanKeypoints& from = source_scan.keypoints(sigma, signal, intensity, dog, cancel);
+        const ScanKeypoints& to = target_scan.keypoints(sigma, signal, intensity, dog, cancel);
+        sets.signal = to.signal;
+        sets.source = from.points, sets.source_labels = from.labels;
+        sets.target = to.points, sets.target_labels = to.labels;
         return 0;
       });
     } else {
@@ -448,10 +443,10 @@ ScaleAttempt register_at_scale(const PointCloud& source, const PointCloud& targe
 // too few keypoints or no well-supported pose, down to the point spacing.
 class ScaleLadder {
  public:
-  ScaleLadder(const PointCloud& source, const PointCloud& target, double min_scale_m)
+  ScaleLadder(const PreparedScan& source, const PreparedScan& target, double min_scale_m)
       : source_(source), target_(target), start_m_(min_scale_m) {
     if (start_m_ == 0.0) {
-      const Sampling s = measure_sampling(source), t = measure_sampling(target);
+      const Sampling &s = source.sampling(), &t = target.sampling();
       spacing_m_ = std::max(s.spacing_m, t.spacing_m);
       const double coarsest = std::min(s.diameter_m, t.diameter_m) / kDiameterPerScale;
       start_m_ = std::max(std::min(coarsest, kSpacingsPerScale * spacing_m_), 2.0 * spacing_m_);
@@ -463,7 +458,7 @@ class ScaleLadder {
   // The scale after `scale_m`, or 0 when none is left.
   double next(double scale_m, int tried) {
     if (tried >= kMaxScales) return 0.0;
-    if (spacing_m_ < 0) spacing_m_ = std::max(measure_sampling(source_).spacing_m, measure_sampling(target_).spacing_m);
+    if (spacing_m_ < 0) spacing_m_ = std::max(source_.sampling().spacing_m, target_.sampling().spacing_m);
     return 0.5 * scale_m >= spacing_m_ ? 0.5 * scale_m : 0.0;
   }
 
@@ -475,8 +470,8 @@ class ScaleLadder {
   static constexpr double kDiameterPerScale = 128.0;
   static constexpr double kSpacingsPerScale = 10.0;
   static constexpr int kMaxScales = 4;
-  const PointCloud& source_;
-  const PointCloud& target_;
+  const PreparedScan& source_;
+  const PreparedScan& target_;
   double start_m_;
   double spacing_m_ = -1.0;  // measured when first needed
 };
@@ -492,7 +487,7 @@ void add_timings(std::vector<StageTiming>& total, const std::vector<StageTiming>
   }
 }
 
-RegistrationResult run(const PointCloud& source, const PointCloud& target, const RegistrationParams& params,
+RegistrationResult run(const PreparedScan& source, const PreparedScan& target, const RegistrationParams& params,
                        const CancellationToken* cancel, const ProgressCallback& progress) {
   ScaleLadder ladder(source, target, params.min_scale_m);
   std::optional<RegistrationResult> best;
@@ -525,9 +520,15 @@ RegistrationResult run(const PointCloud& source, const PointCloud& target, const
 
 RegistrationResult register_clouds(const PointCloud& source, const PointCloud& target, const RegistrationParams& params,
                                    const CancellationToken* cancel, const ProgressCallback& progress) {
+  return register_clouds(PreparedScan(source), PreparedScan(target), params, cancel, progress);
+}
+
+RegistrationResult register_clouds(const PreparedScan& source, const PreparedScan& target,
+                                   const RegistrationParams& params, const CancellationToken* cancel,
+                                   const ProgressCallback& progress) {
   validate(params);
-  if (source.empty()) fail(ErrorCode::kInvalidArgument, "source cloud is empty");
-  if (target.empty()) fail(ErrorCode::kInvalidArgument, "target cloud is empty");
+  if (source.cloud().empty()) fail(ErrorCode::kInvalidArgument, "source cloud is empty");
+  if (target.cloud().empty()) fail(ErrorCode::kInvalidArgument, "target cloud is empty");
   // A time budget becomes a deadline on a private token that also follows the caller's cancellation.
   CancellationToken budget(cancel);
   if (params.time_budget_s > 0)

@@ -20,6 +20,10 @@ struct PointCloud {
   bool has_intensity() const { return !intensity.empty() && intensity.size() == points.size(); }
 };
 
+// Where the scanner stood, for a scan in its scanner's frame: the file frame's origin, i.e. -origin_m in the
+// cloud's local frame.
+inline Eigen::Vector3f scanner_position(const PointCloud& cloud) { return (-cloud.origin_m).cast<float>(); }
+
 // Builds a cloud from double-precision coordinates: picks a local origin (rounded centre of the
 // bounding box) and stores float offsets from it. Throws kInvalidArgument on NaN/Inf and on coordinates
 // beyond +-1e12 (whose offsets would not fit a float).

@@ -11,6 +11,7 @@
 
 #include "k4reg/geometry/point_cloud.h"
 #include "k4reg/project/candidate_pairs.h"
+#include "k4reg/registration/prepared_scan.h"
 #include "k4reg/registration/registration.h"
 #include "k4reg/util/cancellation.h"
 #include "k4reg/util/error.h"
@@ -31,19 +32,21 @@ class PairRunner {
   virtual ~PairRunner() = default;
   // Registers pairs[k] = (source, target) for every k, calling done(k, outcome) as each finishes, one call at a
   // time. Throws k4reg::Error kCancelled / kDeadlineExceeded once `cancel` fires (pairs in flight are dropped).
-  virtual void run(const std::vector<PointCloud>& scans, const std::vector<ScanPair>& pairs,
+  // The scans are prepared once for the whole project (prepared_scan.h): a runner that registers here shares
+  // their voxels and keypoints between pairs; one that sends pairs elsewhere sends their clouds.
+  virtual void run(const std::vector<PreparedScan>& scans, const std::vector<ScanPair>& pairs,
                    const RegistrationParams& params, const CancellationToken* cancel, const Done& done) = 0;
 };
 
 // In this process, in order, each pair on params.threads threads.
 class LocalPairRunner : public PairRunner {
  public:
-  void run(const std::vector<PointCloud>& scans, const std::vector<ScanPair>& pairs, const RegistrationParams& params,
+  void run(const std::vector<PreparedScan>& scans, const std::vector<ScanPair>& pairs, const RegistrationParams& params,
            const CancellationToken* cancel, const Done& done) override;
 };
 
 // One pair in this process, as LocalPairRunner runs it (for a runner that falls back to local work).
-PairOutcome register_pair(const PointCloud& source, const PointCloud& target, const RegistrationParams& params,
+PairOutcome register_pair(const PreparedScan& source, const PreparedScan& target, const RegistrationParams& params,
                           const CancellationToken* cancel);
 
 }  // namespace k4reg

@@ -41,9 +41,12 @@ struct IcpPyramid {
   std::vector<Stage> stages;
 };
 
-// points: at spacing params.voxel_m (coarser stages are voxelised from them).
+// points: at spacing params.voxel_m (coarser stages are voxelised from them). as_target: with each stage's
+// neighbour grid and normals (add_target_search), which the target of a registration needs.
 IcpPyramid make_icp_pyramid(const std::vector<Eigen::Vector3f>& points, const IcpParams& params, bool as_target,
                             const CancellationToken* cancel = nullptr);
+// Adds the neighbour grids and normals to a pyramid made without them (the same as making it as_target).
+void add_target_search(IcpPyramid& pyramid, const IcpParams& params, const CancellationToken* cancel = nullptr);
 
 IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const Eigen::Matrix4d& initial,
                      const IcpParams& params, const CancellationToken* cancel = nullptr);

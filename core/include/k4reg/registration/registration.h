@@ -140,4 +140,11 @@ RegistrationResult register_clouds(const PointCloud& source, const PointCloud& t
                                    const RegistrationParams& params, const CancellationToken* cancel = nullptr,
                                    const ProgressCallback& progress = {});
 
+class PreparedScan;  // prepared_scan.h
+// The same on prepared scans, reusing (and adding to) the work already done on each: a project registers each
+// scan in many pairs. The result equals register_clouds on the two clouds, bit for bit.
+RegistrationResult register_clouds(const PreparedScan& source, const PreparedScan& target,
+                                   const RegistrationParams& params, const CancellationToken* cancel = nullptr,
+                                   const ProgressCallback& progress = {});
+
 }  // namespace k4reg

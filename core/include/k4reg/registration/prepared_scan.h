@@ -1,0 +1,60 @@
+// One scan and the work registration does on it alone: its sampling, and per scale its voxel grid, ICP pyramid,
+// DoG keypoints and free-space image. Each is computed when first asked for and then kept, so a project computes
+// them once per scan instead of once per pair (a scan is in up to N - 1 pairs); register_clouds on two plain
+// clouds prepares them on the fly. An entry is exactly what register_clouds computes for the scan alone, so
+// results do not depend on the sharing.
+// Thread-safe: pairs running at once share the entries (the first to ask computes, the others wait; a cancelled
+// computation leaves the entry to the next asker).
+// Memory, per scale used: the voxel grid (16 B per voxel, 20 with intensity), the pyramid (its points, and for a
+// target its neighbour grids and normals: about 60 B per voxel in all), the keypoints and the free-space image.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "k4reg/geometry/point_cloud.h"
+#include "k4reg/geometry/sampling.h"
+#include "k4reg/geometry/voxel_grid.h"
+#include "k4reg/registration/dog_keypoints.h"
+#include "k4reg/registration/free_space.h"
+#include "k4reg/registration/icp.h"
+#include "k4reg/registration/surface_signal.h"
+#include "k4reg/util/cancellation.h"
+
+namespace k4reg {
+
+// A scan's DoG keypoints on one signal: the points 4PCS matches and their extremum labels (1 maximum, 0 minimum).
+struct ScanKeypoints {
+  std::string signal;  // the signal they came from: "intensity" or "geometric"
+  std::vector<Eigen::Vector3f> points;
+  std::vector<std::uint8_t> labels;
+};
+
+class PreparedScan {
+ public:
+  // Keeps a reference: the cloud must outlive this.
+  explicit PreparedScan(const PointCloud& cloud);
+  PreparedScan(PreparedScan&&) noexcept;
+  ~PreparedScan();
+
+  const PointCloud& cloud() const { return *cloud_; }
+  const Sampling& sampling() const;
+  const VoxelizedCloud& voxels(double sigma_m, const CancellationToken* cancel) const;
+  // At sigma_m's voxels, with params' stages; as_target adds the neighbour grids and normals.
+  const IcpPyramid& pyramid(double sigma_m, const IcpParams& params, bool as_target,
+                            const CancellationToken* cancel) const;
+  // use_intensity: whether the pair uses intensity (both scans have it); see make_surface_signal.
+  const ScanKeypoints& keypoints(double sigma_m, KeypointSignal signal, bool use_intensity, const DogParams& dog,
+                                 const CancellationToken* cancel) const;
+  // The raw points seen from the scanner (the file frame's origin), with this margin.
+  const FreeSpaceImage& free_space(double margin_m) const;
+
+ private:
+  struct Cache;  // the entries, each made once
+  const PointCloud* cloud_;
+  std::unique_ptr<Cache> cache_;
+};
+
+}  // namespace k4reg

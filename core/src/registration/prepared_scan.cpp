@@ -1,0 +1,95 @@
+#include "k4reg/registration/prepared_scan.h"
+
+#include <map>
+#include <mutex>
+#include <tuple>
+
+namespace k4reg {
+namespace {
+
+// Values by key, each made once from what `make` returns (std::call_once: a maker that throws leaves the entry
+// to the next caller).
+template <typename Key, typename Value>
+class Entries {
+ public:
+  template <typename Make>
+  Value& get(const Key& key, const Make& make) {
+    Entry* entry;
+    {
+      const std::lock_guard lock(mutex_);
+      std::unique_ptr<Entry>& slot = entries_[key];
+      if (!slot) slot = std::make_unique<Entry>();
+      entry = slot.get();
+    }
+    std::call_once(entry->once, [&] { entry->value = std::make_unique<Value>(make()); });
+    return *entry->value;
+  }
+
+ private:
+  struct Entry {
+    std::once_flag once;
+    std::unique_ptr<Value> value;
+  };
+  std::mutex mutex_;
+  std::map<Key, std::unique_ptr<Entry>> entries_;
+};
+
+struct Pyramid {
+  explicit Pyramid(IcpPyramid made) : pyramid(std::move(made)) {}
+  IcpPyramid pyramid;
+  std::once_flag target_search;  // the grids and normals, added when the scan first serves as a target
+};
+
+}  // namespace
+
+struct PreparedScan::Cache {
+  Entries<int, Sampling> sampling;
+  Entries<double, VoxelizedCloud> voxels;
+  Entries<std::tuple<double, int, double>, Pyramid> pyramids;  // sigma, stages, distance factor
+  Entries<std::tuple<double, int, bool, int, int, double>, ScanKeypoints> keypoints;  // sigma, signal, DoG
+  Entries<double, FreeSpaceImage> free_space;
+};
+
+PreparedScan::PreparedScan(const PointCloud& cloud) : cloud_(&cloud), cache_(std::make_unique<Cache>()) {}
+PreparedScan::PreparedScan(PreparedScan&&) noexcept = default;
+PreparedScan::~PreparedScan() = default;
+
+const Sampling& PreparedScan::sampling() const {
+  return cache_->sampling.get(0, [&] { return measure_sampling(*cloud_); });
+}
+
+const VoxelizedCloud& PreparedScan::voxels(double sigma_m, const CancellationToken* cancel) const {
+  return cache_->voxels.get(sigma_m, [&] { return voxel_grid(*cloud_, sigma_m, cancel); });
+}
+
+const IcpPyramid& PreparedScan::pyramid(double sigma_m, const IcpParams& params, bool as_target,
+                                        const CancellationToken* cancel) const {
+  IcpParams at_sigma = params;
+  at_sigma.voxel_m = sigma_m;
+  Pyramid& entry = cache_->pyramids.get({sigma_m, params.stages, params.max_distance_factor}, [&] {
+    return make_icp_pyramid(voxels(sigma_m, cancel).cloud.points, at_sigma, false, cancel);
+  });
+  if (as_target) std::call_once(entry.target_search, [&] { add_target_search(entry.pyramid, at_sigma, cancel); });
+  return entry.pyramid;
+}
+
+const ScanKeypoints& PreparedScan::keypoints(double sigma_m, KeypointSignal signal, bool use_intensity,
+                                             const DogParams& dog, const CancellationToken* cancel) const {
+  const std::tuple key{sigma_m, static_cast<int>(signal), use_intensity, dog.octaves, dog.scales_per_octave,
+                       dog.min_contrast};
+  return cache_->keypoints.get(key, [&] {
+    const PointCloud& at_sigma = voxels(sigma_m, cancel).cloud;
+    const SurfaceSignal surface = make_surface_signal(at_sigma, sigma_m, signal, use_intensity, cancel);
+    DogKeypoints found = detect_dog_keypoints(at_sigma.points, surface.values, dog, cancel);
+    ScanKeypoints out{surface.name, std::move(found.points), {}};
+    for (const float response : found.response) out.labels.push_back(response > 0.0f);
+    return out;
+  });
+}
+
+const FreeSpaceImage& PreparedScan::free_space(double margin_m) const {
+  return cache_->free_space.get(margin_m,
+                                [&] { return FreeSpaceImage(cloud_->points, scanner_position(*cloud_), margin_m); });
+}
+
+}  // namespace k4reg
