@@ -36,6 +36,8 @@ stop_all() {
 }
 pairs_received() { curl -s "http://127.0.0.1:$(cat "$work/$1.http")/metrics" |
   awk '/^k4reg_pair_jobs_received_total\{code="OK"\}/ {n += $2} END {print n + 0}'; }
+bytes_sent() { curl -s "http://127.0.0.1:$(cat "$work/$1.http")/metrics" |
+  awk '/^k4reg_peer_pair_bytes_sent_total\{/ {n += $2} END {printf "%.1f MB", n / 1e6}'; }
 
 run() {  # run LABEL REPLICA...: the project through the first replica
   local label=$1 coordinator=$2
@@ -47,6 +49,7 @@ run() {  # run LABEL REPLICA...: the project through the first replica
   t1=$(date +%s.%N)
   local received=()
   for r in "$coordinator" "$@"; do received+=("$r=$(pairs_received "$r")"); done
+  received+=("sent $(bytes_sent "$coordinator")")
   /usr/bin/python3 - "$work/$label.json" "$label" "$(echo "$t1 - $t0" | bc)" "${received[*]}" <<'EOF'
 import json, statistics, sys
 j = json.load(open(sys.argv[1]))

@@ -50,6 +50,7 @@ void handle_metrics(const ServiceContext& service, HttpExchange& exchange) {
   snapshot.pair_queue_depth = service.pair_queue.waiting();
   snapshot.pair_workers_busy = service.pair_queue.running();
   snapshot.pair_workers = service.pair_queue.workers();
+  snapshot.pair_cache_bytes = service.pair_scans.bytes();
   snapshot.memory_reserved_bytes = service.memory.in_use();
   exchange.reply(200, service.metrics.exposition(snapshot), kPrometheusContentType);
 }

@@ -63,12 +63,14 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
   MemoryBudget memory(config.memory_budget_mb << 20);
   JobQueue queue(config.workers, config.queue_size);
   JobQueue pair_queue(config.pair_workers, config.pair_queue_size);
+  ScanCache pair_scans(config.pair_cache_mb << 20);
   v1::ServerInfo info;
   info.set_version(K4REG_VERSION);
   info.set_server_id(config.server_id);
   Metrics metrics(K4REG_VERSION);
   const ServiceContext context{queue,
                          pair_queue,
+                         pair_scans,
                          memory,
                          paths,
                          spool,

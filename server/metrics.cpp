@@ -144,9 +144,10 @@ void Metrics::job_rejected(std::string_view reason) {
   rejected_[labels({{"reason", reason}})] += 1;
 }
 
-void Metrics::peer_pair_sent(std::string_view peer) {
+void Metrics::peer_pair_sent(std::string_view peer, std::uint64_t bytes) {
   std::lock_guard lock(mutex_);
   peer_sent_[labels({{"peer", peer}})] += 1;
+  peer_sent_bytes_[labels({{"peer", peer}})] += double(bytes);
 }
 
 void Metrics::peer_pair_retried(std::string_view peer, std::string_view code) {
@@ -186,7 +187,10 @@ std::string Metrics::exposition(const Snapshot& s) const {
            cancelled_);
     family(out, "k4reg_jobs_rejected_total", "counter", "Jobs the queue refused, by reason (queue_full, draining).",
            rejected_);
-    family(out, "k4reg_peer_pairs_sent_total", "counter", "Pair jobs this coordinator sent, by peer address.", peer_sent_);
+    family(out, "k4reg_peer_pairs_sent_total", "counter", "Pair calls this coordinator made, by peer address.", peer_sent_);
+    family(out, "k4reg_peer_pair_bytes_sent_total", "counter",
+           "Bytes of the pair calls this coordinator made (scans a peer holds go as digests), by peer address.",
+           peer_sent_bytes_);
     family(out, "k4reg_peer_pairs_retried_total", "counter",
            "Pair calls that failed and were tried again, by peer address and status code.", peer_retried_);
     family(out, "k4reg_peer_pairs_failed_total", "counter",
@@ -202,6 +206,8 @@ std::string Metrics::exposition(const Snapshot& s) const {
          double(s.pair_queue_depth));
   metric(out, "k4reg_pair_workers_busy", "gauge", "Pair workers running a job.", double(s.pair_workers_busy));
   metric(out, "k4reg_pair_workers", "gauge", "Pair workers (--pair-workers).", double(s.pair_workers));
+  metric(out, "k4reg_pair_cache_bytes", "gauge", "Scans of pair jobs kept with their preparation (estimated bytes).",
+         double(s.pair_cache_bytes));
   metric(out, "k4reg_memory_reserved_bytes", "gauge", "Estimated memory reserved by running jobs.",
          double(s.memory_reserved_bytes));
   process_metrics(out, start_time_s_);

@@ -49,10 +49,10 @@ class Metrics {
   // The queue refused a job: `reason` is "queue_full" or "draining".
   void job_rejected(std::string_view reason);
 
-  // k4reg-server --peers, on the coordinator: a pair job was sent to `peer` (its address); a call to it did not
+  // k4reg-server --peers, on the coordinator: a pair job of `bytes` was sent to `peer` (its address); a call to it did not
   // give the pair's outcome (`code`) and the pair is tried again; no peer registered a pair and it ran here
   // (`reason`: "peers_failed" or "too_large").
-  void peer_pair_sent(std::string_view peer);
+  void peer_pair_sent(std::string_view peer, std::uint64_t bytes);
   void peer_pair_retried(std::string_view peer, std::string_view code);
   void peer_pair_failed(std::string_view reason);
   // On a peer: a RegisterPair call ended with `code`.
@@ -62,6 +62,7 @@ class Metrics {
   struct Snapshot {
     std::size_t queue_depth = 0, queue_capacity = 0, workers_busy = 0, workers = 0;
     std::size_t pair_queue_depth = 0, pair_workers_busy = 0, pair_workers = 0;  // RegisterPair jobs
+    std::size_t pair_cache_bytes = 0;  // their scans kept (scan_cache.h)
     std::size_t memory_reserved_bytes = 0;
   };
   std::string exposition(const Snapshot& snapshot) const;
@@ -73,7 +74,7 @@ class Metrics {
   std::map<std::string, Histogram> request_seconds_;  // rendered labels -> latency
   std::map<std::string, double> upload_bytes_;        // rendered labels -> bytes
   std::map<std::string, double> rejected_;            // rendered labels -> count
-  std::map<std::string, double> peer_sent_, peer_retried_, peer_failed_, pairs_received_;  // rendered labels -> count
+  std::map<std::string, double> peer_sent_, peer_sent_bytes_, peer_retried_, peer_failed_, pairs_received_;  // by labels
   Histogram job_seconds_, queue_wait_seconds_;
   double points_ = 0, cancelled_ = 0;
   const double start_time_s_;  // since the Unix epoch

@@ -17,19 +17,32 @@ PairReactor::PairReactor(ServiceContext& service, grpc::CallbackServerContext* c
   }
   try {
     params_ = params_from_proto(request->params());
-    source_ = cloud_from_proto(request->source(), service_.limits.max_points);
-    target_ = cloud_from_proto(request->target(), service_.limits.max_points);
+    source_ = held_scan(request->source());
+    target_ = held_scan(request->target());
   } catch (...) {
     finish(status_from_current_exception());
     return;
   }
-  record_.source_points = source_.size();
-  record_.target_points = target_.size();
+  record_.source_points = source_->cloud.size();
+  record_.target_points = target_->cloud.size();
   job_ = std::make_shared<Job>([this](Job& job) { execute(job); });
   apply_deadline(*context, job_->token());
   std::size_t position = 0;
   // From here on a worker may already be running the job: touch nothing it uses.
   if (const grpc::Status status = service_.submit_pair(job_, position); !status.ok()) finish(status);
+}
+
+std::shared_ptr<const ScanCache::Scan> PairReactor::held_scan(const v1::PairCloud& message) {
+  const std::string name = message.name().empty() ? "a pair cloud" : message.name();
+  if (message.points_xyz().empty() && !message.digest().empty()) {
+    auto held = service_.pair_scans.find(message.digest());
+    if (!held) fail(ErrorCode::kNotFound, name + " is not held here: send its points");
+    return held;
+  }
+  const std::string digest = cloud_digest(message);
+  if (!message.digest().empty() && message.digest() != digest)
+    fail(ErrorCode::kInvalidArgument, name + ": the digest does not match the points");
+  return service_.pair_scans.insert(digest, cloud_from_proto(message, service_.limits.max_points));
 }
 
 void PairReactor::execute(Job& job) {
@@ -38,10 +51,12 @@ void PairReactor::execute(Job& job) {
     job.token().throw_if_stopped();  // cancelled or expired while queued
     // No waiting for memory: the coordinator's project may be what holds it (here or on its replica), so a busy
     // budget is backpressure the coordinator answers by trying elsewhere or later.
-    const auto reservation = service_.memory.try_reserve(kBytesPerPoint * (source_.size() + target_.size()));
+    const auto reservation =
+        service_.memory.try_reserve(kBytesPerPoint * (source_->cloud.size() + target_->cloud.size()));
     if (!reservation) fail(ErrorCode::kResourceExhausted, "the memory budget is in use by other jobs; try again later");
     if (params_.threads == 0 || params_.threads > service_.limits.job_threads) params_.threads = service_.limits.job_threads;
-    result_to_proto(register_clouds(source_, target_, params_, &job.token()), reply_->mutable_result());
+    result_to_proto(register_clouds(source_->prepared, target_->prepared, params_, &job.token()),
+                    reply_->mutable_result());
     *reply_->mutable_server() = service_.server_info;
   } catch (...) {
     status = status_from_current_exception();

@@ -53,10 +53,15 @@ PeerPairRunner::PeerPairRunner(std::shared_ptr<grpc::Channel> peers, const PeerO
 
 void PeerPairRunner::run(const std::vector<PreparedScan>& scans, const std::vector<ScanPair>& pairs,
                          const RegistrationParams& params, const CancellationToken* cancel, const Done& done) {
-  // Each scan is encoded once, whatever the number of pairs it is in.
-  std::vector<v1::PairCloud> clouds(scans.size());
-  for (std::size_t i = 0; i < scans.size(); ++i)
+  // Each scan is encoded once, whatever the number of pairs it is in; its digest stands for it where a peer holds
+  // it from an earlier pair.
+  std::vector<v1::PairCloud> clouds(scans.size()), digests(scans.size());
+  for (std::size_t i = 0; i < scans.size(); ++i) {
     cloud_to_proto(scans[i].cloud(), "scan " + std::to_string(i), &clouds[i]);
+    clouds[i].set_digest(cloud_digest(clouds[i]));
+    digests[i].set_name(clouds[i].name());
+    digests[i].set_digest(clouds[i].digest());
+  }
   v1::RegistrationParams sent;
   params_to_proto(params, &sent);
   auto stub = v1::Registration::NewStub(peers_);
@@ -73,11 +78,18 @@ void PeerPairRunner::run(const std::vector<PreparedScan>& scans, const std::vect
     const auto start = Clock::now();
     double backoff = options_.first_backoff_s;
     int waits = 0;
+    // First the digests only: a peer that holds both scans from earlier pairs needs nothing else (and has their
+    // voxels and keypoints); one that does not answers NOT_FOUND, and the points follow at once.
     v1::RegisterPairRequest request;
-    *request.mutable_source() = clouds[pairs[k].first];
-    *request.mutable_target() = clouds[pairs[k].second];
+    auto with = [&](const std::vector<v1::PairCloud>& sent_clouds) {
+      *request.mutable_source() = sent_clouds[pairs[k].first];
+      *request.mutable_target() = sent_clouds[pairs[k].second];
+    };
     *request.mutable_params() = sent;
+    with(clouds);
     const bool fits = request.ByteSizeLong() <= options_.max_pair_bytes;
+    with(digests);
+    bool with_points = false;
     for (int failed = 0; fits && failed < options_.attempts && !stop;) {
       grpc::ClientContext context;
       context.AddMetadata("x-request-id", caller_.request_id);
@@ -87,7 +99,12 @@ void PeerPairRunner::run(const std::vector<PreparedScan>& scans, const std::vect
       const grpc::Status status = stub->RegisterPair(&context, request, &reply);
       calls.remove(&context);
       const std::string peer = context.peer().empty() ? "none" : context.peer();
-      metrics_.peer_pair_sent(peer);
+      metrics_.peer_pair_sent(peer, request.ByteSizeLong());
+      if (status.error_code() == grpc::StatusCode::NOT_FOUND && !with_points) {
+        with_points = true;
+        with(clouds);
+        continue;
+      }
       if (status.ok() || is_pair_outcome(status.error_code())) {
         PairOutcome outcome;
         if (status.ok())

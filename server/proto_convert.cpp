@@ -1,7 +1,10 @@
 #include "proto_convert.h"
 
+#include <openssl/evp.h>
+
 #include <bit>
 #include <cstring>
+#include <memory>
 #include <string>
 
 #include "k4reg/util/error.h"
@@ -224,6 +227,22 @@ PointCloud cloud_from_proto(const v1::PairCloud& m, std::size_t max_points) {
   for (const Eigen::Vector3f& p : cloud.points)
     if (!p.allFinite()) fail(ErrorCode::kInvalidArgument, name + ": a point is NaN or infinite");
   return cloud;
+}
+
+std::string cloud_digest(const v1::PairCloud& m) {
+  static_assert(std::endian::native == std::endian::little, "the digest covers little-endian float64 origins");
+  const std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> context(EVP_MD_CTX_new(), EVP_MD_CTX_free);
+  std::string digest(EVP_MAX_MD_SIZE, '\0');
+  unsigned int length = 0;
+  bool ok = context && EVP_DigestInit_ex(context.get(), EVP_sha256(), nullptr) == 1 &&
+            EVP_DigestUpdate(context.get(), m.points_xyz().data(), m.points_xyz().size()) == 1 &&
+            EVP_DigestUpdate(context.get(), m.intensity().data(), m.intensity().size()) == 1;
+  for (const double coordinate : m.origin_m())
+    ok = ok && EVP_DigestUpdate(context.get(), &coordinate, sizeof coordinate) == 1;
+  if (!ok || EVP_DigestFinal_ex(context.get(), reinterpret_cast<unsigned char*>(digest.data()), &length) != 1)
+    fail(ErrorCode::kInternal, "SHA-256 failed");
+  digest.resize(length);
+  return digest;
 }
 
 }  // namespace k4reg::service

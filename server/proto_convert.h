@@ -27,6 +27,8 @@ void params_to_proto(const RegistrationParams& params, v1::RegistrationParams* m
 // (kInvalidArgument) and clouds over max_points (kResourceExhausted; 0 = unlimited).
 void cloud_to_proto(const PointCloud& cloud, const std::string& name, v1::PairCloud* message);
 PointCloud cloud_from_proto(const v1::PairCloud& message, std::size_t max_points);
+// SHA-256 of the cloud's points_xyz, intensity and origin_m (float64 little-endian): what PairCloud.digest holds.
+std::string cloud_digest(const v1::PairCloud& message);
 
 // Row-major 4x4 -> 16 repeated doubles.
 void matrix_to_proto(const Eigen::Matrix4d& matrix, google::protobuf::RepeatedField<double>* values);

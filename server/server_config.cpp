@@ -41,6 +41,11 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
   app.add_option("--pair-queue-size", c.pair_queue_size, "pairs that may wait; beyond: RESOURCE_EXHAUSTED")
       ->envname("K4REG_PAIR_QUEUE_SIZE")
       ->capture_default_str();
+  app.add_option("--pair-cache-mb", c.pair_cache_mb,
+                 "scans of other replicas' pair jobs kept with their voxels and keypoints (60 B per point), MiB; "
+                 "0 = none kept")
+      ->envname("K4REG_PAIR_CACHE_MB")
+      ->capture_default_str();
   app.add_option("--peer-in-flight", c.peer_in_flight, "pairs of one project out to the peers at once")
       ->envname("K4REG_PEER_IN_FLIGHT")
       ->capture_default_str()
@@ -140,6 +145,7 @@ nlohmann::json config_to_json(const ServerConfig& c) {
           {"pair_workers", c.pair_workers},
           {"pair_queue_size", c.pair_queue_size},
           {"peer_in_flight", c.peer_in_flight},
+          {"pair_cache_mb", c.pair_cache_mb},
           {"max_pair_mb", c.max_pair_mb},
           {"job_threads", c.job_threads},
           {"max_points", c.max_points},

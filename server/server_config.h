@@ -22,6 +22,7 @@ struct ServerConfig {
   std::size_t pair_workers = 0;               // RegisterPair jobs at once (peers' pairs); 0 = workers
   std::size_t pair_queue_size = 16;           // RegisterPair jobs waiting; beyond: RESOURCE_EXHAUSTED (backpressure)
   int peer_in_flight = 4;                     // a coordinated project's pairs out at once
+  std::size_t pair_cache_mb = 512;            // scans of peers' pair jobs kept, with their preparation
   int job_threads = 1;                        // core threads per job; parallelism comes from the workers
   std::size_t max_points = 50'000'000;        // per cloud; 0 = unlimited
   std::size_t memory_budget_mb = 0;           // for all running jobs; 0 = half the physical memory

@@ -17,6 +17,7 @@
 #include "path_policy.h"
 #include "peer_pair_runner.h"
 #include "registration_job.h"
+#include "scan_cache.h"
 #include "request_log.h"
 #include "spool.h"
 
@@ -25,6 +26,7 @@ namespace k4reg::service {
 struct ServiceContext {
   JobQueue& queue;
   JobQueue& pair_queue;  // RegisterPair jobs from coordinating peers: their own workers, so projects cannot deadlock
+  ScanCache& pair_scans;  // the scans of those pair jobs, with their preparation, by digest
   MemoryBudget& memory;
   const PathPolicy& paths;
   SpoolDir& spool;

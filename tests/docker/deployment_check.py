@@ -473,10 +473,11 @@ def check_kubernetes(d, problems):
         # Peers' pair jobs are held in memory while they wait and run, beside the budget their registration uses.
         pair_workers = int(values.get("K4REG_PAIR_WORKERS") or 0) or workers
         pairs = math.ceil(float(values["K4REG_MAX_PAIR_MB"]) * (pair_workers + int(values["K4REG_PAIR_QUEUE_SIZE"])))
+        pairs += int(values["K4REG_PAIR_CACHE_MB"])  # their scans, kept with their preparation
         needed = budget + inline + pairs + PROCESS_OVERHEAD_MIB
         problems.expect(0 < budget and needed <= quantity(limits["memory"]), where,
                         f"memory limit {limits['memory']} < budget {budget} + inline requests {inline} + pair jobs "
-                        f"{pairs} + process {PROCESS_OVERHEAD_MIB} MiB")
+                        f"and their kept scans {pairs} + process {PROCESS_OVERHEAD_MIB} MiB")
 
     security = {**pod["spec"].get("securityContext", {}), **container.get("securityContext", {})}
     problems.expect(security.get("runAsNonRoot") is True, where, "runAsNonRoot must be true")

@@ -74,7 +74,7 @@ BREAKAGES = [
     ("k8s/deployment.yaml", 'K4REG_MEMORY_BUDGET_MB\n              value: "3072"', 'K4REG_MEMORY_BUDGET_MB\n              value: "5000"',
      "memory limit 5Gi < budget 5000"),
     ("k8s/deployment.yaml", 'K4REG_MAX_PAIR_MB\n              value: "128"', 'K4REG_MAX_PAIR_MB\n              value: "512"',
-     "pair jobs 2048"),
+     "their kept scans 2560"),
     ("k8s/deployment.yaml", "K4REG_PEERS", "K4REG_PEER", "K4REG_PEER is not a k4reg-server variable"),
     ("k8s/deployment.yaml", "containerPort: 8080", "containerPort: 8081", "container ports"),
     ("k8s/deployment.yaml", 'prometheus.io/port: "8080"', 'prometheus.io/port: "9090"', "prometheus.io/port 9090 is not the HTTP port"),

@@ -120,15 +120,29 @@ double metric_sum(const ServerProcess& server, const std::string& name, const st
   return sum;
 }
 
-TEST_F(ServicePeers, MetricsCountThePairsSentAndReceivedPerPeer) {
+TEST_F(ServicePeers, PeersKeepTheScansSoTheNextPairsTravelAsDigests) {
   ServerProcess b({"--workers", "1"});
   ServerProcess a({"--data-root", bunny_dir().string(), "--workers", "1", "--peers", peers_of({&b})});
-  const ProjectCall call = register_project(a);
-  ASSERT_TRUE(call.status.ok()) << call.status.error_message();
-  EXPECT_EQ(metric_sum(a, "k4reg_peer_pairs_sent_total", "peer=\"ipv4:" + b.address() + "\""), 6);
+  const std::string to_b = "peer=\"ipv4:" + b.address() + "\"";
+  const ProjectCall first = register_project(a);
+  ASSERT_TRUE(first.status.ok()) << first.status.error_message();
   EXPECT_EQ(metric_sum(b, "k4reg_pair_jobs_received_total", "code=\"OK\""), 6);
+  EXPECT_GT(metric_sum(b, "k4reg_pair_cache_bytes"), 0);
   EXPECT_EQ(metric_sum(a, "k4reg_peer_pairs_failed_total"), 0);
   EXPECT_EQ(metric_sum(b, "k4reg_peer_pairs_sent_total"), 0) << "b coordinated nothing";
+  // Each of the 4 scans travelled once at most, in one of the calls NOT_FOUND sent back for its points.
+  const double calls = metric_sum(a, "k4reg_peer_pairs_sent_total", to_b);
+  const double bytes = metric_sum(a, "k4reg_peer_pair_bytes_sent_total", to_b);
+  EXPECT_GE(calls, 6);
+  EXPECT_LE(metric_sum(b, "k4reg_pair_jobs_received_total", "code=\"NOT_FOUND\""), 6);
+
+  // The same project again: b holds every scan, so each pair is one call of digests, and the poses are the same.
+  const ProjectCall second = register_project(a);
+  ASSERT_TRUE(second.status.ok()) << second.status.error_message();
+  expect_same_poses(second.response.result(), *reference_);
+  EXPECT_EQ(metric_sum(a, "k4reg_peer_pairs_sent_total", to_b) - calls, 6);
+  EXPECT_LT(metric_sum(a, "k4reg_peer_pair_bytes_sent_total", to_b) - bytes, 6 * 1000) << "digests, not points";
+  EXPECT_EQ(metric_sum(b, "k4reg_pair_jobs_received_total", "code=\"OK\""), 12);
 }
 
 // A port no one listens on now (the kernel's pick, released): for a replica that must name itself as its peer.
