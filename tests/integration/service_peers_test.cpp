@@ -2,6 +2,7 @@
 // the coordinator has the single-replica poses bit for bit and says where its pairs ran (response, metrics, the
 // peers' access logs); a peer killed with SIGKILL or drained mid-project loses nothing; a peer whose pair queue is
 // full is backpressure, not failure; replicas coordinating at once serve each other's pairs.
+// RegisterPair itself refuses bad clouds with the upload status codes and needs the bearer token.
 #include <gtest/gtest.h>
 
 #include <arpa/inet.h>
@@ -10,9 +11,12 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <limits>
 #include <sstream>
 #include <thread>
 
+#include "k4reg/io/cloud_io.h"
+#include "proto_convert.h"
 #include "test_support.h"
 
 namespace k4reg::test {
@@ -246,6 +250,110 @@ TEST_F(ServicePeers, NoPeerAnsweringRunsThePairsLocally) {
   ASSERT_TRUE(call.status.ok()) << call.status.error_message();
   expect_same_poses(call.response.result(), *reference_);
   EXPECT_EQ(call.response.pairs_local(), 6u);
+}
+
+// RegisterPair answers a peer, but it is a public RPC like any other: bad clouds get the status codes of bad
+// uploads, and the bearer token guards it.
+class PairJobs : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    for (const char* scan : {"bun045.ply", "bun000.ply"}) {
+      const PointCloud cloud = read_cloud((bunny_dir() / scan).string());
+      service::cloud_to_proto(cloud, scan, &clouds_.emplace_back());
+    }
+  }
+  static v1::RegisterPairRequest request() {
+    v1::RegisterPairRequest request;
+    *request.mutable_source() = clouds_[0];
+    *request.mutable_target() = clouds_[1];
+    *request.mutable_params() = quick_params();
+    return request;
+  }
+  static grpc::Status call(const ServerProcess& server, const v1::RegisterPairRequest& request,
+                           const std::string& token = "") {
+    grpc::ClientContext context;
+    set_timeout(context, std::chrono::seconds(60));
+    if (!token.empty()) context.AddMetadata("authorization", "Bearer " + token);
+    v1::RegisterPairResponse reply;
+    return server.stub()->RegisterPair(&context, request, &reply);
+  }
+  static std::vector<v1::PairCloud> clouds_;
+};
+
+std::vector<v1::PairCloud> PairJobs::clouds_;
+
+TEST_F(PairJobs, BadCloudsAreRefusedWithTheUploadsStatusCodes) {
+  ServerProcess server({"--workers", "1", "--max-points", "45000"});  // the bunny scans have 40-41 k points
+  ASSERT_TRUE(call(server, request()).ok());
+
+  v1::RegisterPairRequest torn = request();
+  torn.mutable_source()->mutable_points_xyz()->pop_back();
+  torn.mutable_source()->clear_digest();
+  EXPECT_TRUE(has_status(call(server, torn), grpc::StatusCode::INVALID_ARGUMENT, "bun045.ply points_xyz"));
+
+  v1::RegisterPairRequest nan = request();
+  const float not_a_number = std::numeric_limits<float>::quiet_NaN();
+  nan.mutable_target()->mutable_points_xyz()->replace(4, sizeof not_a_number,
+                                                      reinterpret_cast<const char*>(&not_a_number), sizeof not_a_number);
+  EXPECT_TRUE(has_status(call(server, nan), grpc::StatusCode::INVALID_ARGUMENT, "NaN"));
+
+  v1::RegisterPairRequest mismatched = request();
+  mismatched.mutable_source()->set_digest(service::cloud_digest(clouds_[1]));
+  EXPECT_TRUE(has_status(call(server, mismatched), grpc::StatusCode::INVALID_ARGUMENT, "digest does not match"));
+
+  v1::RegisterPairRequest no_origin = request();
+  no_origin.mutable_target()->clear_origin_m();
+  EXPECT_TRUE(has_status(call(server, no_origin), grpc::StatusCode::INVALID_ARGUMENT, "origin_m"));
+
+  v1::RegisterPairRequest short_intensity = request();
+  short_intensity.mutable_source()->set_intensity(std::string(8, '\0'));
+  EXPECT_TRUE(has_status(call(server, short_intensity), grpc::StatusCode::INVALID_ARGUMENT, "intensity"));
+
+  v1::RegisterPairRequest unknown = request();
+  unknown.mutable_source()->clear_points_xyz();
+  unknown.mutable_source()->set_digest(std::string(32, 'x'));
+  EXPECT_TRUE(has_status(call(server, unknown), grpc::StatusCode::NOT_FOUND, "send its points"));
+
+  v1::RegisterPairRequest empty = request();
+  empty.mutable_target()->clear_points_xyz();
+  EXPECT_TRUE(has_status(call(server, empty), grpc::StatusCode::INVALID_ARGUMENT, "empty"));
+
+  v1::RegisterPairRequest degenerate = request();  // every point in one place
+  const std::string first_point = degenerate.target().points_xyz().substr(0, 12);
+  std::string same;
+  for (int i = 0; i < 1000; ++i) same += first_point;
+  degenerate.mutable_target()->set_points_xyz(same);
+  degenerate.mutable_target()->clear_intensity();
+  EXPECT_TRUE(has_status(call(server, degenerate), grpc::StatusCode::INVALID_ARGUMENT, "occupied voxels"));
+
+  v1::RegisterPairRequest huge = request();
+  const std::string& points = huge.source().points_xyz();
+  huge.mutable_source()->set_points_xyz(points + points);
+  EXPECT_TRUE(has_status(call(server, huge), grpc::StatusCode::RESOURCE_EXHAUSTED, "--max-points"));
+
+  // The refusals left the server serving, and none of the bad clouds was kept.
+  ASSERT_TRUE(call(server, request()).ok());
+  unknown.mutable_source()->set_digest(service::cloud_digest(nan.target()));
+  EXPECT_EQ(call(server, unknown).error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+TEST_F(PairJobs, NeedTheBearerTokenAndCoordinatorsSendIt) {
+  ServerProcess b({"--workers", "1", "--auth-token", "s3cret"});
+  EXPECT_TRUE(has_status(call(b, request()), grpc::StatusCode::UNAUTHENTICATED, "authorization"));
+  EXPECT_EQ(call(b, request(), "wrong").error_code(), grpc::StatusCode::UNAUTHENTICATED);
+  ServerProcess a({"--data-root", bunny_dir().string(), "--workers", "1", "--auth-token", "s3cret", "--peers",
+                   peers_of({&b})});
+  auto stub = a.stub();
+  grpc::ClientContext context;
+  context.AddMetadata("authorization", "Bearer s3cret");
+  set_timeout(context, std::chrono::minutes(3));
+  v1::RegisterProjectResponse response;
+  auto reader = stub->RegisterProject(&context, project_request());
+  for (v1::RegisterProjectEvent event; reader->Read(&event);)
+    if (event.has_result()) response = event.result();
+  const grpc::Status status = reader->Finish();
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(response.pairs_on_peers(), 6u);
 }
 
 }  // namespace
