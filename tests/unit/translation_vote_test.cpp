@@ -47,5 +47,21 @@ TEST(TranslationVote, IsDeterministicAndEmptyForNoPoints) {
   EXPECT_TRUE(vote_translations({}, target, Eigen::Matrix3d::Identity(), 0.25, 4).empty());
 }
 
+// Votes are counted in an array over the box of possible shifts, or in a hash map where that box is too
+// large (a stray point kilometres away): both count the same cells, so the answer is the same.
+TEST(TranslationVote, AFarStrayPointChangesNothing) {
+  const std::vector<Eigen::Vector3f> target = box({4, -2, 1});
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  std::vector<Eigen::Vector3f> source;
+  for (const Eigen::Vector3f& q : target) source.push_back((r.transpose() * (q.cast<double>() - Eigen::Vector3d(1.03, 2.04, 0.02))).cast<float>());
+  std::vector<Eigen::Vector3f> stray = target;
+  stray.emplace_back(3000.0f, -2000.0f, 500.0f);  // 3 km x 2 km x 0.5 km of shifts at 0.1 m: 3e12 cells
+  const auto near = vote_translations(source, target, r, 0.1, 3), far = vote_translations(source, stray, r, 0.1, 3);
+  ASSERT_EQ(near.size(), 3u);
+  ASSERT_EQ(far.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(near[i], far[i]) << i;
+  EXPECT_LT((near[0] - Eigen::Vector3d(1.03, 2.04, 0.02)).cwiseAbs().maxCoeff(), 0.15);
+}
+
 }  // namespace
 }  // namespace k4reg

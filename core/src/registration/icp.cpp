@@ -114,6 +114,24 @@ IcpPyramid make_icp_pyramid(const std::vector<Eigen::Vector3f>& points, const Ic
   return pyramid;
 }
 
+std::vector<Eigen::Vector3f> every_kth(const std::vector<Eigen::Vector3f>& points, std::size_t max_points) {
+  const std::size_t step = std::max<std::size_t>(1, (points.size() + max_points - 1) / max_points);
+  std::vector<Eigen::Vector3f> out;
+  out.reserve(points.size() / step + 1);
+  for (std::size_t i = 0; i < points.size(); i += step) out.push_back(points[i]);
+  return out;
+}
+
+IcpPyramid thin_pyramid(const IcpPyramid& pyramid, std::size_t max_points) {
+  IcpPyramid thin;
+  thin.stages.resize(pyramid.stages.size());
+  for (std::size_t s = 0; s < pyramid.stages.size(); ++s) {
+    thin.stages[s].voxel_m = pyramid.stages[s].voxel_m;
+    thin.stages[s].points = every_kth(pyramid.stages[s].points, max_points);
+  }
+  return thin;
+}
+
 void add_target_search(IcpPyramid& pyramid, const IcpParams& params, const CancellationToken* cancel) {
   for (IcpPyramid::Stage& s : pyramid.stages) {
     check(cancel);
@@ -129,7 +147,7 @@ IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const E
   result.transform = initial;
   const std::size_t stages =
       std::min({static_cast<std::size_t>(std::max(params.stages, 1)), source.stages.size(), target.stages.size()});
-  for (std::size_t stage = 0; stage < stages; ++stage) {
+  for (std::size_t stage = params.finest_stage_only ? stages - 1 : 0; stage < stages; ++stage) {
     const auto& src = source.stages[stage];
     const auto& tgt = target.stages[stage];
     const double voxel = tgt.voxel_m;

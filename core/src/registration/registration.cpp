@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <fmt/format.h>
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -172,6 +173,7 @@ constexpr double kAutoOverlaps[] = {0.8, 0.6, 0.4};
 // Hypotheses whose cloud score is within this share of the best are refined fully and judged again.
 constexpr double kContenderBand = 0.2;
 constexpr std::size_t kMaxContenders = 3;
+constexpr std::size_t kContenderPoints = 15000;  // per ICP stage: a pose to well under a voxel
 
 // The single-scale pipeline's outcome: the result, and whether its pose is well supported.
 struct ScaleAttempt {
@@ -343,10 +345,14 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   while (contenders < std::min(kMaxContenders, result.hypotheses.size()) &&
          result.hypotheses[contenders].cloud_score >= (1.0 - kContenderBand) * result.hypotheses.front().cloud_score)
     ++contenders;
+  // Contenders refine on a thinned source, side by side (each sum is deterministic); the winner is then
+  // polished on every point at the finest stage, which also gives its quality figures.
+  const IcpPyramid contender_source = thin_pyramid(icp.first, kContenderPoints);
   std::vector<IcpResult> refined(contenders);
   timer.run("icp", [&] {
-    for (std::size_t i = 0; i < contenders; ++i)
-      refined[i] = refine_icp(icp.first, icp.second, result.hypotheses[i].transform, final_params, cancel);
+    tbb::parallel_for(std::size_t{0}, contenders, [&](std::size_t i) {
+      refined[i] = refine_icp(contender_source, icp.second, result.hypotheses[i].transform, final_params, cancel);
+    });
     return 0;
   });
   // Per contender: the share of the source the target explains once refined, and how much of what comes
@@ -354,17 +360,17 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   const PoseScorer scorer(icp.first, icp.second, free_space ? &views : nullptr, result.overlap_used);
   std::vector<std::size_t> kept;
   timer.run("verdict", [&] {
-    for (std::size_t i = 0; i < contenders; ++i) {
+    tbb::parallel_for(std::size_t{0}, contenders, [&](std::size_t i) {
       Hypothesis& h = result.hypotheses[i];
       if (params.icp) h.transform = refined[i].transform;
-      if (std::any_of(kept.begin(), kept.end(), [&](std::size_t k) {
-            return !distinct_transforms(result.hypotheses[k].transform, h.transform, 2.0, 2.0 * sigma);
-          }))
-        continue;
       h.refined_score = scorer.score(h.transform);
       if (params.icp) h.surface_agreement = scorer.surface_agreement(h.transform);
-      kept.push_back(i);
-    }
+    });
+    for (std::size_t i = 0; i < contenders; ++i)
+      if (std::none_of(kept.begin(), kept.end(), [&](std::size_t k) {
+            return !distinct_transforms(result.hypotheses[k].transform, result.hypotheses[i].transform, 2.0, 2.0 * sigma);
+          }))
+        kept.push_back(i);
     return 0;
   });
   // A pose off the target surface cannot be the true one, however well supported: contenders on the
@@ -392,11 +398,14 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   for (std::size_t i : kept) reordered.push_back(result.hypotheses[i]);
   reordered.insert(reordered.end(), result.hypotheses.begin() + contenders, result.hypotheses.end());
   result.hypotheses = std::move(reordered);
-  const IcpResult& final_icp = refined[winner];
+  // The winner polished on every source point at the finest stage; with --no-icp, its quality figures only.
+  IcpParams polish = final_params;
+  polish.finest_stage_only = true;
   const Hypothesis& best = result.hypotheses.front();
+  const IcpResult final_icp = timer.run("polish", [&] { return refine_icp(icp.first, icp.second, best.transform, polish, cancel); });
   const Eigen::Matrix4d local = params.icp ? final_icp.transform : best.transform;
   result.icp_converged = params.icp && final_icp.converged;
-  result.icp_iterations = params.icp ? final_icp.iterations : 0;
+  result.icp_iterations = params.icp ? refined[winner].iterations + final_icp.iterations : 0;
   result.rmse_m = final_icp.rmse_m;
   result.overlap = final_icp.overlap;
   result.inliers = final_icp.inliers;

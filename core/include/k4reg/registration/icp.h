@@ -19,6 +19,7 @@ struct IcpParams {
   int max_iterations = 50;           // per stage
   double max_distance_factor = 2.5;  // correspondences within this many stage voxels
   bool levelled = false;             // only rotations about z (and translations): 4 unknowns, not 6
+  bool finest_stage_only = false;    // polish a pose already refined on the coarser stages
 };
 
 struct IcpResult {
@@ -45,6 +46,11 @@ struct IcpPyramid {
 // neighbour grid and normals (add_target_search), which the target of a registration needs.
 IcpPyramid make_icp_pyramid(const std::vector<Eigen::Vector3f>& points, const IcpParams& params, bool as_target,
                             const CancellationToken* cancel = nullptr);
+// Every k-th point, at most max_points of them: an even subsample of a voxelised cloud, in its order.
+std::vector<Eigen::Vector3f> every_kth(const std::vector<Eigen::Vector3f>& points, std::size_t max_points);
+// every_kth of each stage, at most max_points per stage (a source for ICP: no grids, no normals).
+// A pose needs thousands of well-spread correspondences; ICP's cost is linear in them.
+IcpPyramid thin_pyramid(const IcpPyramid& pyramid, std::size_t max_points);
 // Adds the neighbour grids and normals to a pyramid made without them (the same as making it as_target).
 void add_target_search(IcpPyramid& pyramid, const IcpParams& params, const CancellationToken* cancel = nullptr);
 
