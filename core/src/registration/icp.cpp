@@ -166,7 +166,7 @@ IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const E
       if (angle > 0) step.topLeftCorner<3, 3>() = Eigen::AngleAxisd(angle, delta.head<3>() / angle).toRotationMatrix();
       step.topRightCorner<3, 1>() = delta.tail<3>();
       result.transform = step * result.transform;
-      if (angle < 1e-6 && delta.tail<3>().norm() < 1e-4 * voxel) {
+      if (angle < 1e-2 * params.converged_step_voxels && delta.tail<3>().norm() < params.converged_step_voxels * voxel) {
         result.converged = true;
         break;
       }

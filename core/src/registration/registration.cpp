@@ -348,10 +348,12 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   // Contenders refine on a thinned source, side by side (each sum is deterministic); the winner is then
   // polished on every point at the finest stage, which also gives its quality figures.
   const IcpPyramid contender_source = thin_pyramid(icp.first, kContenderPoints);
+  IcpParams contender_params = final_params;
+  contender_params.converged_step_voxels = kSettledStepVoxels;
   std::vector<IcpResult> refined(contenders);
   timer.run("icp", [&] {
     tbb::parallel_for(std::size_t{0}, contenders, [&](std::size_t i) {
-      refined[i] = refine_icp(contender_source, icp.second, result.hypotheses[i].transform, final_params, cancel);
+      refined[i] = refine_icp(contender_source, icp.second, result.hypotheses[i].transform, contender_params, cancel);
     });
     return 0;
   });

@@ -144,6 +144,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   quick.stages = kStages;
   quick.max_iterations = kIterations;
   quick.levelled = levelled;
+  quick.converged_step_voxels = kSettledStepVoxels;
   // A hypothesis can be a metre or two off where it matters, beyond the guard's ICP stages: a 4PCS fit on
   // keypoints a few metres apart tilts a wide outdoor scene by degrees, and a twin's estimated centre is
   // rough. Two wider stages (2 and 4 times the pyramid's coarsest spacing, a few thousand points) reach
@@ -154,6 +155,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   wide.stages = 2;
   wide.max_iterations = 10;
   wide.levelled = levelled;
+  wide.converged_step_voxels = kSettledStepVoxels;
   const IcpPyramid wide_source = thin_pyramid(make_icp_pyramid(source.stages.front().points, wide, false, cancel), kSettlePoints);
   const IcpPyramid wide_target = make_icp_pyramid(target.stages.front().points, wide, true, cancel);
   auto settle = [&](Hypothesis& h) {

@@ -75,8 +75,16 @@ class VoteCounts {
   std::vector<Eigen::Vector3i> indices_;
 };
 
+// floor() without a call into libm (the build targets baseline x86-64, which has no rounding instruction): the
+// same cells, several times faster over millions of votes.
+int floor_to_int(float x) {
+  const int i = static_cast<int>(x);
+  return i - (x < static_cast<float>(i));
+}
+
 Eigen::Vector3i cell_of(const Eigen::Vector3f& shift, float inverse_cell) {
-  return (shift * inverse_cell).array().floor().cast<int>();
+  const Eigen::Vector3f scaled = shift * inverse_cell;
+  return {floor_to_int(scaled.x()), floor_to_int(scaled.y()), floor_to_int(scaled.z())};
 }
 
 }  // namespace

@@ -20,7 +20,13 @@ struct IcpParams {
   double max_distance_factor = 2.5;  // correspondences within this many stage voxels
   bool levelled = false;             // only rotations about z (and translations): 4 unknowns, not 6
   bool finest_stage_only = false;    // polish a pose already refined on the coarser stages
+  // A stage has converged once a step moves the cloud by less than this many stage voxels (and turns it by less
+  // than a hundredth of that in radians).
+  double converged_step_voxels = 1e-4;
 };
+
+// Converged enough to compare poses (the symmetry guard, contenders for the verdict); a winner is polished after.
+constexpr double kSettledStepVoxels = 1e-2;
 
 struct IcpResult {
   Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();
