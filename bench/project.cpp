@@ -1,8 +1,12 @@
 // k4reg-bench-project: project registration (register_project, as `k4reg align-project` runs it) on
 // simulated and real projects, split into a tuning part and a held-out part like k4reg-bench-blind.
 //
-//   k4reg-bench-project [--part tuning|held-out|all] [--suites NAME,...] [--seeds N] [--data-dir DIR]
+//   k4reg-bench-project [--part tuning|held-out|all|scaling] [--suites NAME,...] [--seeds N] [--data-dir DIR]
 //                       [--cache-dir DIR] [--results-dir DIR] [--markdown FILE] [--list]
+//
+// The scaling part (not in "all": about 20 minutes) registers the courtyard's first 6, 12 and 24 stations at 1 M
+// points, all pairs, and splits the time into reading, the per-scan stages, the pairs, selection and refinement.
+// It writes its own CSV (project-scaling-runs.csv) and RESULTS.md block ("project-scaling").
 //
 // Every scan's pose is scored against the ground truth relative to the reference scan (RMS over the
 // scan's points of the distance between where the pose and the truth put them) and counted as correct,
@@ -36,6 +40,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 struct Project {
+  double read_seconds = 0.0;  // reading the scan files (not simulating them)
   std::vector<PointCloud> scans;
   std::vector<Eigen::Matrix4d> truth;  // scan -> a common frame
 };
@@ -53,6 +58,8 @@ struct Run {
   std::size_t scans = 0, correct = 0, unregistered = 0, confident_misses = 0, links = 0, accepted = 0;
   std::size_t loops = 0, inconsistent = 0;
   double worst_rmse_m = 0.0, seconds = 0.0;
+  double read_seconds = 0.0;
+  std::vector<StageTiming> timings;  // the project's: pairwise stages summed over pairs, selection, refinement
   bool refused = false;
   std::string note;
 };
@@ -68,7 +75,9 @@ Suite simulated(const std::string& scene, int layout, std::vector<int> stations,
     Project p;
     for (int st : stations) {
       const CachedScan c = cached_simulated_scan(cache, scene, st, points, layout);
+      const auto start = Clock::now();
       p.scans.push_back(read_cloud(c.path));
+      p.read_seconds += std::chrono::duration<double>(Clock::now() - start).count();
       p.truth.push_back(c.scan_to_scene);
     }
     return p;
@@ -104,6 +113,12 @@ Suite real(std::string name, std::string what, const fs::path& folder, std::vect
   return s;
 }
 
+std::vector<int> stations_up_to(int n) {
+  std::vector<int> stations(n);
+  for (int i = 0; i < n; ++i) stations[i] = i;
+  return stations;
+}
+
 std::vector<Suite> all_suites(const fs::path& data, const std::string& cache) {
   const fs::path bunny = data / "stanford-bunny-scans";
   // Tuning: what the selection was developed on (the bunny's ten scans, hall layout 0, monument layout 3).
@@ -126,6 +141,9 @@ std::vector<Suite> all_suites(const fs::path& data, const std::string& cache) {
       simulated("courtyard", 0, {0, 1, 2, 3}, 700000, 0.1, 0.1, 0.4, "held-out", cache),
       simulated("hall", 3, {0, 1, 2, 4}, 700000, 0.05, 0.1, 0.4, "held-out", cache),
       simulated("object", 2, {0, 1, 2, 3, 4, 5, 6, 7, 8, 9}, 40000, 0.001, 0.002, 0.5, "held-out", cache),
+      simulated("courtyard", 0, stations_up_to(6), 1000000, 0.1, 0.1, 0.4, "scaling", cache),
+      simulated("courtyard", 0, stations_up_to(12), 1000000, 0.1, 0.1, 0.4, "scaling", cache),
+      simulated("courtyard", 0, stations_up_to(24), 1000000, 0.1, 0.1, 0.4, "scaling", cache),
   };
 }
 
@@ -142,6 +160,8 @@ Run run_one(const Suite& suite, std::uint64_t seed) {
   try {
     const ProjectResult r = register_project(project.scans, params);
     run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    run.read_seconds = project.read_seconds;
+    run.timings = r.timings;
     const Eigen::Matrix4d to_reference = project.truth[r.reference].inverse();
     for (std::size_t i = 0; i < r.scans.size(); ++i) {
       if (!r.scans[i].registered) {
@@ -195,6 +215,31 @@ std::string report(const std::vector<Suite>& suites, const std::vector<Run>& run
   return out.str();
 }
 
+double stage_seconds(const Run& r, std::initializer_list<const char*> stages) {
+  double sum = 0.0;
+  for (const StageTiming& t : r.timings)
+    for (const char* stage : stages) sum += t.stage == stage ? t.seconds : 0.0;
+  return sum;
+}
+
+// Where a project's time goes as it grows: reading, the per-scan stages (each scan prepared once), the pairs,
+// selection and refinement; all pairs, so the pairs grow as N(N-1)/2.
+std::string scaling_report(const std::vector<Run>& runs) {
+  std::ostringstream out;
+  out << "| project | scans | pairs | correct | not registered | **confident miss** | wall | read | per-scan stages | pairs | "
+         "selection | refinement |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const Run& r : runs) {
+    if (r.part != "scaling") continue;
+    const double per_scan = stage_seconds(r, {"voxel_grid", "keypoints", "icp_setup"});
+    const double pairs = stage_seconds(r, {"matching", "symmetry_guard", "icp", "verdict", "polish", "plain_grid"});
+    out << fmt::format("| {} | {} | {} | {} | {} | **{}** | {:.1f} s | {:.1f} s | {:.1f} s | {:.1f} s | {:.2f} s | {:.2f} s |\n",
+                       r.suite, r.scans, r.links, r.correct, r.refused ? r.scans : r.unregistered, r.confident_misses,
+                       r.read_seconds + r.seconds, r.read_seconds, per_scan, pairs, stage_seconds(r, {"selection"}),
+                       stage_seconds(r, {"refinement"}));
+  }
+  return out.str();
+}
+
 }  // namespace
 }  // namespace k4reg::bench
 
@@ -203,13 +248,14 @@ int main(int argc, char** argv) {
   CLI::App app{"Registers the tuning and held-out projects and reports both, scan by scan against the truth."};
   SplitOptions o;
   o.seeds = 1;
-  o.add_to(app, "project");
+  o.add_to(app, "project", "scaling");
   CLI11_PARSE(app, argc, argv);
   try {
     const auto suites = all_suites(o.data_dir, o.cache_dir);
     std::vector<Run> runs;
     fs::create_directories(o.results_dir);
-    std::ofstream csv(fs::path(o.results_dir) / "project-runs.csv");
+    const bool scaling = o.part == "scaling";
+    std::ofstream csv(fs::path(o.results_dir) / (scaling ? "project-scaling-runs.csv" : "project-runs.csv"));
     csv << "part,project,seed,scans,correct,unregistered,confident_misses,refused,worst_rmse_m,links,accepted,loops,"
            "loops_inconsistent,seconds,note\n";
     for (const Suite& s : suites) {
@@ -232,9 +278,9 @@ int main(int argc, char** argv) {
       }
     }
     if (o.list) return 0;
-    const std::string table = report(suites, runs);
+    const std::string table = scaling ? scaling_report(runs) : report(suites, runs);
     std::printf("\n%s", table.c_str());
-    if (!o.markdown.empty()) replace_block(o.markdown, "project", table);
+    if (!o.markdown.empty()) replace_block(o.markdown, scaling ? "project-scaling" : "project", table);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "k4reg-bench-project: %s\n", e.what());
     return 1;

@@ -118,6 +118,19 @@ Scene make_courtyard_scene(int layout) {
       {at(0.88, 0.6), "east side, north of the kiosk", {}},
       {at(0.45, 0.88), "north side, between the trees", {}},
   };
+  // Stations 4-23, for projects of many setups: every 4 m or so round the courtyard, 2.5 m from the facades
+  // (clear of the car, the kiosk and the trees), anticlockwise from the south-west corner.
+  const double inset = 2.5, ring_l = l - 2 * inset, ring_w = w - 2 * inset;
+  constexpr int kRing = 20;
+  for (int k = 0; k < kRing; ++k) {
+    double u = k * 2.0 * (ring_l + ring_w) / kRing;  // distance along the ring
+    Vector2d xy;
+    if (u < ring_l) xy = {inset + u, inset};
+    else if ((u -= ring_l) < ring_w) xy = {l - inset, inset + u};
+    else if ((u -= ring_w) < ring_l) xy = {l - inset - u, w - inset};
+    else xy = {inset, w - inset - (u - ring_l)};
+    scene.stations.push_back({Vector3d(xy.x(), xy.y(), kScannerHeight_m), "round the courtyard, 2.5 m from the facades", {}});
+  }
   return scene;
 }
 
