@@ -236,15 +236,16 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     const auto suites = all_suites(o.data_dir, o.cache_dir);
+    if (o.list) {  // before the CSV is opened: listing must not empty the last run's results
+      for (const Suite& s : suites)
+        std::printf("%-22s %-9s %zu pairs  %s\n", s.name.c_str(), s.part.c_str(), s.pairs.size(), s.what.c_str());
+      return 0;
+    }
     std::vector<Run> runs;
     fs::create_directories(o.results_dir);
     std::ofstream csv(fs::path(o.results_dir) / "blind-runs.csv");
     csv << "part,suite,pair,seed,success,ambiguous,refused,rmse_m,seconds,min_scale_m_used,overlap_used,margin,note\n";
     for (const Suite& s : suites) {
-      if (o.list) {
-        std::printf("%-22s %-9s %zu pairs  %s\n", s.name.c_str(), s.part.c_str(), s.pairs.size(), s.what.c_str());
-        continue;
-      }
       if (!o.selected(s.part, s.name)) continue;
       for (std::size_t k = 0; k < s.pairs.size(); ++k)
         for (int seed = 1; seed <= o.seeds; ++seed) {
@@ -260,7 +261,6 @@ int main(int argc, char** argv) {
               << r.margin << ",\"" << r.note << "\"\n";
         }
     }
-    if (o.list) return 0;
     const std::string table = report(suites, runs);
     std::printf("\n%s", table.c_str());
     if (!o.markdown.empty()) replace_block(o.markdown, "blind", table);

@@ -252,6 +252,11 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     const auto suites = all_suites(o.data_dir, o.cache_dir);
+    if (o.list) {  // before the CSV is opened: listing must not empty the last run's results
+      for (const Suite& s : suites)
+        std::printf("%-22s %-9s %s\n", s.name.c_str(), s.part.c_str(), s.what.c_str());
+      return 0;
+    }
     std::vector<Run> runs;
     fs::create_directories(o.results_dir);
     const bool scaling = o.part == "scaling";
@@ -259,10 +264,6 @@ int main(int argc, char** argv) {
     csv << "part,project,seed,scans,correct,unregistered,confident_misses,refused,worst_rmse_m,links,accepted,loops,"
            "loops_inconsistent,seconds,note\n";
     for (const Suite& s : suites) {
-      if (o.list) {
-        std::printf("%-22s %-9s %s\n", s.name.c_str(), s.part.c_str(), s.what.c_str());
-        continue;
-      }
       if (!o.selected(s.part, s.name)) continue;
       for (int seed = 1; seed <= o.seeds; ++seed) {
         const Run r = run_one(s, seed);
@@ -277,7 +278,6 @@ int main(int argc, char** argv) {
             << r.loops << ',' << r.inconsistent << ',' << r.seconds << ",\"" << r.note << "\"\n";
       }
     }
-    if (o.list) return 0;
     const std::string table = scaling ? scaling_report(runs) : report(suites, runs);
     std::printf("\n%s", table.c_str());
     if (!o.markdown.empty()) replace_block(o.markdown, scaling ? "project-scaling" : "project", table);
