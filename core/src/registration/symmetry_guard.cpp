@@ -132,7 +132,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
                                     bool levelled, const CancellationToken* cancel) {
   constexpr int kStages = 2, kIterations = 6;  // settle, don't polish: the final ICP does that
   // A pose settles on a few thousand points and is scored on ten thousand (a share to within ~0.5 %: the
-  // contenders are scored again on all of them once refined).
+  // contenders are scored again on up to 30 000 once refined).
   constexpr std::size_t kSettlePoints = 4000, kScoredPoints = 10000;
   const IcpPyramid settling_source = thin_pyramid(source, kSettlePoints);
   const std::vector<Eigen::Vector3f> scored = every_kth(source.stages.at(kStages - 1).points, kScoredPoints);
