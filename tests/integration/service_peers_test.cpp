@@ -39,11 +39,13 @@ struct ProjectCall {
   int pairs_seen = 0;
 };
 
-// `after_first_pair` runs once the first pair event arrives.
-ProjectCall register_project(const ServerProcess& server, const std::function<void()>& after_first_pair = {}) {
+// `after_first_pair` runs once the first pair event arrives; `token`, if any, is sent as the bearer token.
+ProjectCall register_project(const ServerProcess& server, const std::function<void()>& after_first_pair = {},
+                             const std::string& token = "") {
   auto stub = server.stub();
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() + std::chrono::minutes(3));
+  if (!token.empty()) context.AddMetadata("authorization", "Bearer " + token);
   ProjectCall call;
   auto reader = stub->RegisterProject(&context, project_request());
   for (v1::RegisterProjectEvent event; reader->Read(&event);) {
@@ -343,17 +345,9 @@ TEST_F(PairJobs, NeedTheBearerTokenAndCoordinatorsSendIt) {
   EXPECT_EQ(call(b, request(), "wrong").error_code(), grpc::StatusCode::UNAUTHENTICATED);
   ServerProcess a({"--data-root", bunny_dir().string(), "--workers", "1", "--auth-token", "s3cret", "--peers",
                    peers_of({&b})});
-  auto stub = a.stub();
-  grpc::ClientContext context;
-  context.AddMetadata("authorization", "Bearer s3cret");
-  set_timeout(context, std::chrono::minutes(3));
-  v1::RegisterProjectResponse response;
-  auto reader = stub->RegisterProject(&context, project_request());
-  for (v1::RegisterProjectEvent event; reader->Read(&event);)
-    if (event.has_result()) response = event.result();
-  const grpc::Status status = reader->Finish();
-  ASSERT_TRUE(status.ok()) << status.error_message();
-  EXPECT_EQ(response.pairs_on_peers(), 6u);
+  const ProjectCall project = register_project(a, {}, "s3cret");
+  ASSERT_TRUE(project.status.ok()) << project.status.error_message();
+  EXPECT_EQ(project.response.pairs_on_peers(), 6u);
 }
 
 }  // namespace
