@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 
 namespace k4reg {
 namespace {
@@ -61,6 +63,30 @@ TEST(TranslationVote, AFarStrayPointChangesNothing) {
   ASSERT_EQ(far.size(), 3u);
   for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(near[i], far[i]) << i;
   EXPECT_LT((near[0] - Eigen::Vector3d(1.03, 2.04, 0.02)).cwiseAbs().maxCoeff(), 0.15);
+}
+
+// A row of equal boxes 4 m apart (a corridor's doors), the first seen four times as densely (near the
+// scanner): one box of the source fits each of them, but the dense copy's near misses outvote the others'
+// exact fits. Peaks a cell apart crowd around the dense copy; kept further apart, there is one per box.
+TEST(TranslationVote, SeparatedPeaksFindEveryCopyOfARepeatedObject) {
+  std::vector<Eigen::Vector3f> target;
+  for (const float x : {0.0f, 4.0f, 8.0f}) {
+    const std::vector<Eigen::Vector3f> one = box({x, 0, 0});
+    for (int copy = 0; copy < (x == 0.0f ? 4 : 1); ++copy) target.insert(target.end(), one.begin(), one.end());
+  }
+  const std::vector<Eigen::Vector3f> source = box({0, 0, 0});
+  const auto crowded = vote_translations(source, target, Eigen::Matrix3d::Identity(), 0.2, 3, 1);
+  const auto apart = vote_translations(source, target, Eigen::Matrix3d::Identity(), 0.2, 3, 6);
+  ASSERT_EQ(apart.size(), 3u);
+  std::vector<double> found;
+  for (const Eigen::Vector3d& shift : apart) {
+    EXPECT_LT(std::abs(shift.y()) + std::abs(shift.z()), 0.4);
+    found.push_back(shift.x());
+  }
+  std::sort(found.begin(), found.end());
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(found[i], 4.0 * static_cast<double>(i), 0.25) << i;
+  ASSERT_EQ(crowded.size(), 3u);
+  for (const Eigen::Vector3d& shift : crowded) EXPECT_LT((shift - crowded[0]).norm(), 1.0);
 }
 
 }  // namespace

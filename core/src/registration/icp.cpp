@@ -78,14 +78,20 @@ Eigen::Matrix<double, 6, 1> solve_step(const Accumulation& acc, bool levelled) {
 
 std::vector<Eigen::Vector3f> estimate_normals(const std::vector<Eigen::Vector3f>& points, const NeighborGrid& grid,
                                               double radius_m) {
-  std::vector<Eigen::Vector3f> normals(points.size(), Eigen::Vector3f::Zero());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 4096), [&](const auto& range) {
+  return estimate_normals(points, points, grid, radius_m);
+}
+
+std::vector<Eigen::Vector3f> estimate_normals(const std::vector<Eigen::Vector3f>& queries,
+                                              const std::vector<Eigen::Vector3f>& points, const NeighborGrid& grid,
+                                              double radius_m) {
+  std::vector<Eigen::Vector3f> normals(queries.size(), Eigen::Vector3f::Zero());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), 4096), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
       int count = 0;
-      grid.for_each_within(points[i], static_cast<float>(radius_m), [&](std::uint32_t k, float) {
-        const Eigen::Vector3d q = (points[k] - points[i]).cast<double>();
+      grid.for_each_within(queries[i], static_cast<float>(radius_m), [&](std::uint32_t k, float) {
+        const Eigen::Vector3d q = (points[k] - queries[i]).cast<double>();
         sum += q;
         outer += q * q.transpose();
         ++count;

@@ -18,7 +18,7 @@ constexpr float kOnVoxels = 0.5f;              // "on it": point-to-plane within
 }  // namespace
 
 PoseScorer::PoseScorer(const IcpPyramid& source, const IcpPyramid& target, const ScanViews* views, double overlap)
-    : scored_(every_kth(source.stages.at(std::min(kStage, source.stages.size() - 1)).points, kScoredPoints)),
+    : scored_(scored_source(source.stages.at(std::min(kStage, source.stages.size() - 1)), kScoredPoints)),
       finest_(every_kth(source.stages.back().points, kScoredPoints)),
       reference_(target.stages.at(std::min(kStage, target.stages.size() - 1))),
       finest_reference_(target.stages.back()),

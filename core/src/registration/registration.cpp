@@ -175,6 +175,101 @@ constexpr double kContenderBand = 0.2;
 constexpr std::size_t kMaxContenders = 3;
 constexpr std::size_t kContenderPoints = 15000;  // per ICP stage: a pose to well under a voxel
 
+// Whether two hypotheses nearly as well supported as the best (within the contender band) share a rotation
+// (within 5 degrees) but lie more than min_shift_m apart: the scene repeats under a shift. In a symmetric
+// room the rivals are turned copies of each other instead.
+bool repeats_under_a_shift(const std::vector<Hypothesis>& hypotheses, double min_shift_m) {
+  constexpr double kSameRotationDeg = 5.0;
+  std::vector<const Eigen::Matrix4d*> leading;
+  for (const Hypothesis& h : hypotheses)
+    if (h.cloud_score >= (1.0 - kContenderBand) * hypotheses.front().cloud_score) leading.push_back(&h.transform);
+  for (std::size_t i = 0; i < leading.size(); ++i)
+    for (std::size_t j = i + 1; j < leading.size(); ++j) {
+      const Eigen::Matrix4d &a = *leading[i], &b = *leading[j];
+      const Eigen::Matrix3d r = a.topLeftCorner<3, 3>().transpose() * b.topLeftCorner<3, 3>();
+      const double angle_deg = std::acos(std::clamp((r.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / M_PI;
+      if (angle_deg < kSameRotationDeg && (a.topRightCorner<3, 1>() - b.topRightCorner<3, 1>()).norm() > min_shift_m)
+        return true;
+    }
+  return false;
+}
+
+// The verdict on the guard's ranking: the leading hypotheses refined fully and judged again.
+struct Verdict {
+  std::vector<Hypothesis> hypotheses;  // the winner first, the other contenders after it, the rest as they were
+  double margin = 1.0;                 // (winner - runner-up) / winner, on the refined scores
+  bool on_surface = true;              // whether the winner lies on the target surface
+  int iterations = 0;                  // the winner's ICP iterations
+};
+
+Verdict judge_contenders(const SymmetryGuardResult& guarded, const IcpPyramid& source, const IcpPyramid& target,
+                         const IcpParams& final_params, const PoseScorer& scorer, bool icp, double sigma,
+                         StageTimer& timer, const CancellationToken* cancel) {
+  Verdict verdict;
+  verdict.hypotheses = guarded.hypotheses;
+  verdict.margin = guarded.ambiguity_margin;
+  std::vector<Hypothesis>& hypotheses = verdict.hypotheses;
+  std::size_t contenders = 1;
+  while (contenders < std::min(kMaxContenders, hypotheses.size()) &&
+         hypotheses[contenders].cloud_score >= (1.0 - kContenderBand) * hypotheses.front().cloud_score)
+    ++contenders;
+  // Only contenders carry refined figures (hypotheses judged before may come back from a wider search).
+  for (std::size_t i = contenders; i < hypotheses.size(); ++i) hypotheses[i].refined_score = hypotheses[i].surface_agreement = 0.0;
+  // Contenders refine on a thinned source, side by side (each sum is deterministic); the winner is then
+  // polished on every point at the finest stage, which also gives its quality figures.
+  const IcpPyramid contender_source = thin_pyramid(source, kContenderPoints);
+  IcpParams contender_params = final_params;
+  contender_params.converged_step_voxels = kSettledStepVoxels;
+  std::vector<IcpResult> refined(contenders);
+  timer.run("icp", [&] {
+    tbb::parallel_for(std::size_t{0}, contenders, [&](std::size_t i) {
+      refined[i] = refine_icp(contender_source, target, hypotheses[i].transform, contender_params, cancel);
+    });
+    return 0;
+  });
+  // Per contender: the share of the source the target explains once refined, and how much of what comes
+  // near the target surface lies on it. Contenders that refined into an earlier one's pose drop out.
+  std::vector<std::size_t> kept;
+  timer.run("verdict", [&] {
+    tbb::parallel_for(std::size_t{0}, contenders, [&](std::size_t i) {
+      Hypothesis& h = hypotheses[i];
+      if (icp) h.transform = refined[i].transform;
+      h.refined_score = scorer.score(h.transform);
+      if (icp) h.surface_agreement = scorer.surface_agreement(h.transform);
+    });
+    for (std::size_t i = 0; i < contenders; ++i)
+      if (std::none_of(kept.begin(), kept.end(), [&](std::size_t k) {
+            return !distinct_transforms(hypotheses[k].transform, hypotheses[i].transform, 2.0, 2.0 * sigma);
+          }))
+        kept.push_back(i);
+    return 0;
+  });
+  // A pose off the target surface cannot be the true one, however well supported: contenders on the
+  // surface rank first, then by support (unrefined poses, with --no-icp, are not judged on the surface).
+  auto on_surface = [&](std::size_t i) { return !icp || hypotheses[i].surface_agreement >= kMinSurfaceAgreement; };
+  std::stable_sort(kept.begin(), kept.end(), [&](std::size_t a, std::size_t b) {
+    if (on_surface(a) != on_surface(b)) return on_surface(a);
+    return hypotheses[a].refined_score > hypotheses[b].refined_score;
+  });
+  const std::size_t winner = kept[0];
+  verdict.on_surface = on_surface(winner);
+  verdict.iterations = refined[winner].iterations;
+  // The runner-up is the next contender of the winner's kind; failing one, the best unrefined hypothesis.
+  const auto rival = std::find_if(kept.begin() + 1, kept.end(), [&](std::size_t i) { return on_surface(i) == verdict.on_surface; });
+  const double winner_score = hypotheses[winner].refined_score;
+  if (rival != kept.end())
+    verdict.margin = winner_score > 0 ? std::clamp((winner_score - hypotheses[*rival].refined_score) / winner_score, 0.0, 1.0) : 0.0;
+  else if (contenders > 1)
+    verdict.margin = contenders < hypotheses.size()
+                         ? std::clamp(1.0 - hypotheses[contenders].cloud_score / hypotheses[winner].cloud_score, 0.0, 1.0)
+                         : 1.0;
+  std::vector<Hypothesis> reordered;
+  for (std::size_t i : kept) reordered.push_back(hypotheses[i]);
+  reordered.insert(reordered.end(), hypotheses.begin() + contenders, hypotheses.end());
+  hypotheses = std::move(reordered);
+  return verdict;
+}
+
 // The single-scale pipeline's outcome: the result, and whether its pose is well supported.
 struct ScaleAttempt {
   RegistrationResult result;
@@ -332,8 +427,6 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   result.target_keypoints = chosen->target_keypoints;
   result.bases_tried = bases;
   result.overlap_used = chosen->overlap;
-  result.hypotheses = chosen->guarded.hypotheses;
-  result.ambiguity_margin = chosen->guarded.ambiguity_margin;
 
   // 5. ICP refinement on the voxelised clouds (or just the quality figures with --no-icp). Where
   //    runner-ups come close, each is refined fully and judged on what symmetry does not copy; every
@@ -341,65 +434,25 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   const auto& icp = icp_pyramids();
   IcpParams final_params = icp_params;
   if (!params.icp) final_params.max_iterations = 0;  // quality figures only, at the finest stage
-  std::size_t contenders = 1;
-  while (contenders < std::min(kMaxContenders, result.hypotheses.size()) &&
-         result.hypotheses[contenders].cloud_score >= (1.0 - kContenderBand) * result.hypotheses.front().cloud_score)
-    ++contenders;
-  // Contenders refine on a thinned source, side by side (each sum is deterministic); the winner is then
-  // polished on every point at the finest stage, which also gives its quality figures.
-  const IcpPyramid contender_source = thin_pyramid(icp.first, kContenderPoints);
-  IcpParams contender_params = final_params;
-  contender_params.converged_step_voxels = kSettledStepVoxels;
-  std::vector<IcpResult> refined(contenders);
-  timer.run("icp", [&] {
-    tbb::parallel_for(std::size_t{0}, contenders, [&](std::size_t i) {
-      refined[i] = refine_icp(contender_source, icp.second, result.hypotheses[i].transform, contender_params, cancel);
-    });
-    return 0;
-  });
-  // Per contender: the share of the source the target explains once refined, and how much of what comes
-  // near the target surface lies on it. Contenders that refined into an earlier one's pose drop out.
   const PoseScorer scorer(icp.first, icp.second, free_space ? &views : nullptr, result.overlap_used);
-  std::vector<std::size_t> kept;
-  timer.run("verdict", [&] {
-    tbb::parallel_for(std::size_t{0}, contenders, [&](std::size_t i) {
-      Hypothesis& h = result.hypotheses[i];
-      if (params.icp) h.transform = refined[i].transform;
-      h.refined_score = scorer.score(h.transform);
-      if (params.icp) h.surface_agreement = scorer.surface_agreement(h.transform);
+  auto judge = [&](const SymmetryGuardResult& guarded) {
+    return judge_contenders(guarded, icp.first, icp.second, final_params, scorer, params.icp, sigma, timer, cancel);
+  };
+  Verdict verdict = judge(chosen->guarded);
+  // Where the verdict cannot decide and the hypotheses show the scene repeating under a shift (a corridor's
+  // doors every few metres), the truth may be a shifted copy that 4PCS did not find: the guard searches
+  // wider, from the verdict's winner, and the verdict judges again. Only such pairs pay for it.
+  if (params.icp && verdict.margin < kAmbiguousMargin &&
+      repeats_under_a_shift(verdict.hypotheses, 2.0 * icp.second.stages.front().voxel_m)) {
+    const SymmetryGuardResult wider = timer.run("symmetry_guard", [&] {
+      return rank_hypotheses(icp.first, icp.second, verdict.hypotheses, result.overlap_used, free_space ? &views : nullptr,
+                             params.levelled, cancel, true);
     });
-    for (std::size_t i = 0; i < contenders; ++i)
-      if (std::none_of(kept.begin(), kept.end(), [&](std::size_t k) {
-            return !distinct_transforms(result.hypotheses[k].transform, result.hypotheses[i].transform, 2.0, 2.0 * sigma);
-          }))
-        kept.push_back(i);
-    return 0;
-  });
-  // A pose off the target surface cannot be the true one, however well supported: contenders on the
-  // surface rank first, then by support (unrefined poses, with --no-icp, are not judged on the surface).
-  auto on_surface = [&](std::size_t i) { return !params.icp || result.hypotheses[i].surface_agreement >= kMinSurfaceAgreement; };
-  std::stable_sort(kept.begin(), kept.end(), [&](std::size_t a, std::size_t b) {
-    if (on_surface(a) != on_surface(b)) return on_surface(a);
-    return result.hypotheses[a].refined_score > result.hypotheses[b].refined_score;
-  });
-  const std::size_t winner = kept[0];
-  const bool on_the_surface = on_surface(winner);
-  // The runner-up is the next contender of the winner's kind; failing one, the best unrefined hypothesis.
-  const auto rival = std::find_if(kept.begin() + 1, kept.end(), [&](std::size_t i) { return on_surface(i) == on_the_surface; });
-  const double winner_score = result.hypotheses[winner].refined_score;
-  if (rival != kept.end())
-    result.ambiguity_margin =
-        winner_score > 0 ? std::clamp((winner_score - result.hypotheses[*rival].refined_score) / winner_score, 0.0, 1.0) : 0.0;
-  else if (contenders > 1)
-    result.ambiguity_margin =
-        contenders < result.hypotheses.size()
-            ? std::clamp(1.0 - result.hypotheses[contenders].cloud_score / result.hypotheses[winner].cloud_score, 0.0, 1.0)
-            : 1.0;
-  // The winner first, the other contenders after it, the rest as they were.
-  std::vector<Hypothesis> reordered;
-  for (std::size_t i : kept) reordered.push_back(result.hypotheses[i]);
-  reordered.insert(reordered.end(), result.hypotheses.begin() + contenders, result.hypotheses.end());
-  result.hypotheses = std::move(reordered);
+    verdict = judge(wider);
+  }
+  result.hypotheses = std::move(verdict.hypotheses);
+  result.ambiguity_margin = verdict.margin;
+  const bool on_the_surface = verdict.on_surface;
   // The winner polished on every source point at the finest stage; with --no-icp, its quality figures only.
   IcpParams polish = final_params;
   polish.finest_stage_only = true;
@@ -407,7 +460,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   const IcpResult final_icp = timer.run("polish", [&] { return refine_icp(icp.first, icp.second, best.transform, polish, cancel); });
   const Eigen::Matrix4d local = params.icp ? final_icp.transform : best.transform;
   result.icp_converged = params.icp && final_icp.converged;
-  result.icp_iterations = params.icp ? refined[winner].iterations + final_icp.iterations : 0;
+  result.icp_iterations = params.icp ? verdict.iterations + final_icp.iterations : 0;
   result.rmse_m = final_icp.rmse_m;
   result.overlap = final_icp.overlap;
   result.inliers = final_icp.inliers;

@@ -77,6 +77,15 @@ std::vector<Eigen::Matrix4d> half_turns(const Eigen::Matrix3Xd& axes, const Eige
 
 }  // namespace
 
+ScoredSource scored_source(const IcpPyramid::Stage& stage, std::size_t max_points) {
+  ScoredSource scored;
+  scored.points = every_kth(stage.points, max_points);
+  // Only grazing or not is asked of these normals: a voxel's nearest neighbours (about 8 on a plane) will do.
+  const double radius_m = 1.5 * stage.voxel_m;
+  scored.normals = estimate_normals(scored.points, stage.points, NeighborGrid(stage.points, radius_m), radius_m);
+  return scored;
+}
+
 // Without views: the share of source points with a target point within tau. With the target's free
 // space, a point is also consistent where it lies at the target scanner's first return in its
 // direction (sparse far surfaces have gaps wider than tau), contradicted where the target scanner saw
@@ -84,10 +93,13 @@ std::vector<Eigen::Matrix4d> half_turns(const Eigen::Matrix3Xd& axes, const Eige
 // or no return) or where the two scanners saw its surface from opposite sides. Counting unseen points
 // as misses favours the pose that maps one scanner's occlusion shadows onto the other's — in a
 // symmetric room, the flip. So the score is, of the points with evidence, the share consistent less
-// the share contradicted.
-double cloud_score(const std::vector<Eigen::Vector3f>& source, const IcpPyramid::Stage& reference,
-                   const NeighborGrid& grid, float tau, const Eigen::Matrix4d& t, const ScanViews* views,
-                   double overlap) {
+// the share contradicted. A point whose surface the target scanner would meet at grazing incidence is no
+// evidence either: scanners return little or nothing there (along a corridor's far walls, say), so their
+// free space reaches past such surfaces.
+double cloud_score(const ScoredSource& scored, const IcpPyramid::Stage& reference, const NeighborGrid& grid,
+                   float tau, const Eigen::Matrix4d& t, const ScanViews* views, double overlap) {
+  constexpr float kVisibleCos = 0.1f;  // incidence within about 84 degrees of the surface normal
+  const std::vector<Eigen::Vector3f>& source = scored.points;
   const Eigen::Affine3f a = to_affine3f(t);
   const Eigen::Vector3f source_scanner = views ? Eigen::Vector3f(a * views->source_scanner_m) : Eigen::Vector3f::Zero();
   struct Counts {
@@ -109,7 +121,12 @@ double cloud_score(const std::vector<Eigen::Vector3f>& source, const IcpPyramid:
           if (!views) continue;
           switch (views->target_free_space->classify(q)) {
             case FreeSpaceImage::Seen::kSurface: ++c.consistent; break;
-            case FreeSpaceImage::Seen::kEmpty: ++c.contradicted; break;
+            case FreeSpaceImage::Seen::kEmpty: {
+              const Eigen::Vector3f ray = q - views->target_scanner_m;
+              const bool visible = std::abs((a.linear() * scored.normals[i]).dot(ray)) >= kVisibleCos * ray.norm();
+              ++(visible ? c.contradicted : c.unseen);
+              break;
+            }
             case FreeSpaceImage::Seen::kOccluded:
             case FreeSpaceImage::Seen::kUnknown: ++c.unseen; break;
           }
@@ -129,13 +146,13 @@ double cloud_score(const std::vector<Eigen::Vector3f>& source, const IcpPyramid:
 
 SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& target,
                                     std::vector<Hypothesis> hypotheses, double overlap, const ScanViews* views,
-                                    bool levelled, const CancellationToken* cancel) {
+                                    bool levelled, const CancellationToken* cancel, bool periodic) {
   constexpr int kStages = 2, kIterations = 6;  // settle, don't polish: the final ICP does that
   // A pose settles on a few thousand points and is scored on ten thousand (a share to within ~0.5 %: the
   // contenders are scored again on up to 30 000 once refined).
   constexpr std::size_t kSettlePoints = 4000, kScoredPoints = 10000;
   const IcpPyramid settling_source = thin_pyramid(source, kSettlePoints);
-  const std::vector<Eigen::Vector3f> scored = every_kth(source.stages.at(kStages - 1).points, kScoredPoints);
+  const ScoredSource scored = scored_source(source.stages.at(kStages - 1), kScoredPoints);
   const auto& reference = target.stages.at(kStages - 1);
   const double voxel_m = reference.voxel_m;
   const float tau = static_cast<float>(1.5 * voxel_m);
@@ -158,10 +175,11 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   wide.converged_step_voxels = kSettledStepVoxels;
   const IcpPyramid wide_source = thin_pyramid(make_icp_pyramid(source.stages.front().points, wide, false, cancel), kSettlePoints);
   const IcpPyramid wide_target = make_icp_pyramid(target.stages.front().points, wide, true, cancel);
-  auto settle = [&](Hypothesis& h) {
+  auto settle = [&](Hypothesis& h, bool from_afar) {
     const Eigen::Matrix4d start = h.transform;
     h.transform = refine_icp(settling_source, target, start, quick, cancel).transform;
     h.cloud_score = cloud_score(scored, reference, grid, tau, h.transform, views, overlap);
+    if (!from_afar) return;
     const Eigen::Matrix4d pulled = refine_icp(wide_source, wide_target, start, wide, cancel).transform;
     if (!distinct_transforms(pulled, h.transform, 1.0, target.stages.front().voxel_m)) return;  // same basin
     const Eigen::Matrix4d settled = refine_icp(settling_source, target, pulled, quick, cancel).transform;
@@ -173,10 +191,18 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   };
   auto by_score = [](const Hypothesis& a, const Hypothesis& b) { return a.cloud_score > b.cloud_score; };
   // Hypotheses settle independently (in parallel: a few thousand points each keep one core busy).
-  auto settle_all = [&](std::vector<Hypothesis>& list) {
-    tbb::parallel_for(std::size_t{0}, list.size(), [&](std::size_t i) { settle(list[i]); });
+  // from_afar: also from where the wide stages pull it; a shifted copy lies within a vote cell of its place,
+  // which the guard's own stages reach.
+  auto settle_all = [&](std::vector<Hypothesis>& list, bool from_afar) {
+    tbb::parallel_for(std::size_t{0}, list.size(), [&](std::size_t i) { settle(list[i], from_afar); });
   };
-  settle_all(hypotheses);
+  // Hypotheses that a verdict has refined already (a periodic search) are only scored again.
+  if (periodic)
+    tbb::parallel_for(std::size_t{0}, hypotheses.size(), [&](std::size_t i) {
+      hypotheses[i].cloud_score = cloud_score(scored, reference, grid, tau, hypotheses[i].transform, views, overlap);
+    });
+  else
+    settle_all(hypotheses, true);
   std::stable_sort(hypotheses.begin(), hypotheses.end(), by_score);
   // 4PCS on a symmetric room often finds only the flipped pose; its symmetric twin must compete too.
   // Turned about the principal axes through the target's centre, or about the normals' axes and then
@@ -184,15 +210,13 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   const auto& coarse_source = source.stages.front();
   const auto& coarse_target = target.stages.front();
   if (!hypotheses.empty() && coarse_target.points.size() >= 10) {
-    constexpr std::size_t kVoters = 1500, kShifts = 2;
+    constexpr std::size_t kVoters = 1500;
     const NeighborGrid source_grid(coarse_source.points, 2.5 * coarse_source.voxel_m);
     const std::vector<Eigen::Vector3f> voting_source = normal_space_sample(
         coarse_source.points, estimate_normals(coarse_source.points, source_grid, 2.5 * coarse_source.voxel_m), kVoters);
     const std::vector<Eigen::Vector3f> voting_target =
         normal_space_sample(coarse_target.points, coarse_target.normals, kVoters);
     const Eigen::Vector3d centre = trimmed_centre(coarse_target.points).cast<double>();
-    const Eigen::Matrix4d& best = hypotheses.front().transform;
-    std::vector<Hypothesis> twins;
     auto twin = [](const Eigen::Matrix4d& transform) {
       Hypothesis h;
       h.transform = transform;
@@ -202,24 +226,59 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
     const auto axes = [&](const Eigen::Matrix3d& principal) {
       return levelled ? half_turns(Eigen::Vector3d::UnitZ(), centre) : half_turns(principal, centre);
     };
-    for (const Eigen::Matrix4d& s : axes(point_axes(coarse_target.points, centre))) twins.push_back(twin(s * best));
-    // One vote per axis (1500 x 1500 pairs each), side by side.
-    const std::vector<Eigen::Matrix4d> turns = axes(normal_axes(coarse_target.normals));
-    std::vector<std::vector<Eigen::Vector3d>> shifts(turns.size());
-    tbb::parallel_for(std::size_t{0}, turns.size(), [&](std::size_t i) {
-      shifts[i] = vote_translations(voting_source, voting_target, (turns[i] * best).topLeftCorner<3, 3>(),
-                                    2.0 * coarse_target.voxel_m, kShifts);
-    });
-    for (std::size_t i = 0; i < turns.size(); ++i) {
-      Eigen::Matrix4d turned = turns[i] * best;
-      for (const Eigen::Vector3d& shift : shifts[i]) {
-        turned.topRightCorner<3, 1>() = shift;
-        twins.push_back(twin(turned));
-      }
+    const std::vector<Eigen::Matrix4d> principal_turns = axes(point_axes(coarse_target.points, centre));
+    const std::vector<Eigen::Matrix4d> normal_turns = axes(normal_axes(coarse_target.normals));
+    // Whether the best hypothesis beats the first distinct one by the margin a result needs.
+    auto decisive = [&] {
+      const Hypothesis& best = hypotheses.front();
+      const auto rival = std::find_if(hypotheses.begin() + 1, hypotheses.end(), [&](const Hypothesis& h) {
+        return distinct_transforms(best.transform, h.transform, 2.0, 2.0 * voxel_m);
+      });
+      return rival == hypotheses.end() || best.cloud_score <= 0 ||
+             (best.cloud_score - rival->cloud_score) / best.cloud_score >= kAmbiguousMargin;
+    };
+    // The best hypothesis gets its half-turn twins. If asked (periodic), a twin that wins gets its own, and
+    // while no hypothesis stands out, the best also gets shifted copies: a periodic scene (a corridor's doors, a
+    // facade's windows, racks) repeats under shifts too, and 4PCS tends to find the copy that puts one
+    // scanner where the other stood (their dense near fields then meet). They are the vote's further peaks,
+    // at the best's own rotation and at its half-turns.
+    constexpr std::size_t kTwinShifts = 2, kPeriodicShifts = 12;
+    constexpr int kPeriodicSeparationCells = 3;
+    constexpr int kMaxRounds = 4;
+    std::vector<Eigen::Matrix4d> twinned, shifted;  // the bests expanded so far, each way
+    auto among = [&](const std::vector<Eigen::Matrix4d>& done, const Eigen::Matrix4d& t) {
+      return std::any_of(done.begin(), done.end(),
+                         [&](const Eigen::Matrix4d& d) { return !distinct_transforms(d, t, 2.0, 2.0 * voxel_m); });
+    };
+    for (int round = 0; round < (periodic ? kMaxRounds : 1); ++round) {
+      const Eigen::Matrix4d best = hypotheses.front().transform;
+      const bool twins_only = !among(twinned, best);
+      if (!twins_only && (!periodic || decisive() || among(shifted, best))) break;
+      (twins_only ? twinned : shifted).push_back(best);
+      std::vector<Hypothesis> twins;
+      std::vector<Eigen::Matrix4d> turned;  // the rotations to vote at: target -> target maps composed with best
+      if (twins_only)
+        for (const Eigen::Matrix4d& s : principal_turns) twins.push_back(twin(s * best));
+      else
+        turned.push_back(best);
+      for (const Eigen::Matrix4d& s : normal_turns) turned.push_back(s * best);
+      const std::size_t peaks = twins_only ? kTwinShifts : kPeriodicShifts;
+      // One vote per rotation (1500 x 1500 pairs each), side by side.
+      std::vector<std::vector<Eigen::Vector3d>> shifts(turned.size());
+      tbb::parallel_for(std::size_t{0}, turned.size(), [&](std::size_t i) {
+        shifts[i] = vote_translations(voting_source, voting_target, turned[i].topLeftCorner<3, 3>(),
+                                      2.0 * coarse_target.voxel_m, peaks, twins_only ? 1 : kPeriodicSeparationCells);
+      });
+      for (std::size_t i = 0; i < turned.size(); ++i)
+        for (const Eigen::Vector3d& shift : shifts[i]) {
+          Eigen::Matrix4d moved = turned[i];
+          moved.topRightCorner<3, 1>() = shift;
+          twins.push_back(twin(moved));
+        }
+      settle_all(twins, twins_only);
+      hypotheses.insert(hypotheses.end(), twins.begin(), twins.end());
+      std::stable_sort(hypotheses.begin(), hypotheses.end(), by_score);
     }
-    settle_all(twins);
-    hypotheses.insert(hypotheses.end(), twins.begin(), twins.end());
-    std::stable_sort(hypotheses.begin(), hypotheses.end(), by_score);
   }
   SymmetryGuardResult result;
   // Hypotheses that ICP brought to the same pose are one hypothesis.

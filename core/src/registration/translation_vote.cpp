@@ -91,7 +91,8 @@ Eigen::Vector3i cell_of(const Eigen::Vector3f& shift, float inverse_cell) {
 
 std::vector<Eigen::Vector3d> vote_translations(const std::vector<Eigen::Vector3f>& source,
                                                const std::vector<Eigen::Vector3f>& target,
-                                               const Eigen::Matrix3d& rotation, double cell_m, std::size_t peaks) {
+                                               const Eigen::Matrix3d& rotation, double cell_m, std::size_t peaks,
+                                               int separation_cells) {
   if (source.empty() || target.empty()) return {};
   const Eigen::Matrix3f r = rotation.cast<float>();
   const float inverse_cell = static_cast<float>(1.0 / cell_m);
@@ -139,7 +140,7 @@ std::vector<Eigen::Vector3d> vote_translations(const std::vector<Eigen::Vector3f
     if (shifts.size() == peaks) break;
     const Eigen::Vector3i& head = indices[entry.second];
     if (std::any_of(taken.begin(), taken.end(),
-                    [&](const Eigen::Vector3i& t) { return (t - head).cwiseAbs().maxCoeff() <= 1; }))
+                    [&](const Eigen::Vector3i& t) { return (t - head).cwiseAbs().maxCoeff() <= separation_cells; }))
       continue;
     taken.push_back(head);
     shifts.push_back((head.cast<double>() + Eigen::Vector3d::Constant(0.5)) * cell_m);

@@ -67,5 +67,9 @@ IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const E
 // more); zero where fewer than 3 neighbours.
 std::vector<Eigen::Vector3f> estimate_normals(const std::vector<Eigen::Vector3f>& points, const NeighborGrid& grid,
                                               double radius_m);
+// The same at `queries`, from the neighbours among `points`.
+std::vector<Eigen::Vector3f> estimate_normals(const std::vector<Eigen::Vector3f>& queries,
+                                              const std::vector<Eigen::Vector3f>& points, const NeighborGrid& grid,
+                                              double radius_m);
 
 }  // namespace k4reg

@@ -31,7 +31,7 @@ class PoseScorer {
   double surface_agreement(const Eigen::Matrix4d& t) const;
 
  private:
-  std::vector<Eigen::Vector3f> scored_;  // an even subsample of the source's guard stage
+  ScoredSource scored_;                  // an even subsample of the source's guard stage
   std::vector<Eigen::Vector3f> finest_;  // an even subsample of the source's finest stage
   const IcpPyramid::Stage& reference_;
   const IcpPyramid::Stage& finest_reference_;

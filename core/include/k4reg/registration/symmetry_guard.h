@@ -2,12 +2,16 @@
 // each distinct 4PCS hypothesis is settled by a short coarse ICP and re-scored on the voxelised clouds,
 // where the furniture that breaks a room's symmetry is visible: how much of the source the target
 // covers, less how much of it lands in space the target scanner saw to be empty (points the target
-// scanner could not see, or saw from the other side of their surface, are no evidence). 4PCS on a
-// symmetric room often finds only the flipped pose, so the best hypothesis's twins under half turns
-// compete too: about the target's principal axes through its centre, and about the axes of its normals,
-// shifted to where a translation vote on normal-space samples puts them (translation_vote.h).
-// Cost per hypothesis (and per each of nine twins): a few ICP iterations on a few thousand points
-// from two starts and up to two passes over the coarse source; per vote, 1500 x 1500 votes.
+// scanner could not see, saw from the other side of their surface, or would meet at grazing incidence,
+// are no evidence). 4PCS on a symmetric room often finds only the flipped pose, so the best hypothesis's
+// twins under half turns compete too: about the target's principal axes through its centre, and about
+// the axes of its normals, shifted to where a translation vote on normal-space samples puts them
+// (translation_vote.h). On request (periodic), a twin that wins gets its own twins and, while no hypothesis
+// stands out, the best also gets shifted copies at the vote's further peaks: periodic scenes (a corridor's
+// doors) repeat under shifts, and 4PCS tends to find the copy that puts one scanner where the other stood.
+// Cost per hypothesis (and per twin: nine per round, and up to 48 shifted copies per periodic round): a
+// few ICP iterations on a few thousand points from two starts and up to two passes over the coarse
+// source; per vote, 1500 x 1500 votes.
 #pragma once
 
 #include <vector>
@@ -34,18 +38,28 @@ struct ScanViews {
   Eigen::Vector3f target_scanner_m = Eigen::Vector3f::Zero();
 };
 
-// The share of the source (points in its local frame) that the target explains under t: points with a
-// reference point within tau, less those the target scanner saw through, of the points it could see
-// (see symmetry_guard.cpp). grid: over reference.points, cells of at least tau.
-double cloud_score(const std::vector<Eigen::Vector3f>& source, const IcpPyramid::Stage& reference,
-                   const NeighborGrid& grid, float tau, const Eigen::Matrix4d& t, const ScanViews* views,
-                   double overlap);
+// Source points to score (local frame) and their normals (zero where too few neighbours): free space can
+// only contradict a surface the target scanner would have seen, not one it would meet at grazing incidence.
+struct ScoredSource {
+  std::vector<Eigen::Vector3f> points, normals;
+};
+// An even subsample of at most max_points of a pyramid stage, with normals from the whole stage.
+ScoredSource scored_source(const IcpPyramid::Stage& stage, std::size_t max_points);
+
+// The share of the source that the target explains under t: points with a reference point within tau,
+// less those the target scanner saw through, of the points it could see (see symmetry_guard.cpp).
+// grid: over reference.points, cells of at least tau.
+double cloud_score(const ScoredSource& source, const IcpPyramid::Stage& reference, const NeighborGrid& grid,
+                   float tau, const Eigen::Matrix4d& t, const ScanViews* views, double overlap);
 
 // Uses the two coarsest levels of the ICP pyramids and scores on the second. overlap: the expected share
 // of the source the target sees (the registration's parameter). levelled: the scanners' z axes are vertical,
 // so hypotheses settle by rotations about z only and the symmetric twins are half-turns about z.
+// periodic: while no hypothesis stands out, also try the best one's shifted copies (for a result the
+// verdict could not decide: it costs up to 48 more settles).
 SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& target,
                                     std::vector<Hypothesis> hypotheses, double overlap, const ScanViews* views,
-                                    bool levelled = false, const CancellationToken* cancel = nullptr);
+                                    bool levelled = false, const CancellationToken* cancel = nullptr,
+                                    bool periodic = false);
 
 }  // namespace k4reg

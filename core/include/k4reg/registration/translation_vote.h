@@ -13,10 +13,11 @@
 
 namespace k4reg {
 
-// Up to `peaks` shifts (target = rotation * source + shift), most votes first, each more than a cell
-// from the earlier ones. Deterministic: ties go to the smaller cell key.
+// Up to `peaks` shifts (target = rotation * source + shift), most votes first, each more than
+// `separation_cells` cells (per axis) from the earlier ones. Deterministic: ties go to the smaller cell key.
 std::vector<Eigen::Vector3d> vote_translations(const std::vector<Eigen::Vector3f>& source,
                                                const std::vector<Eigen::Vector3f>& target,
-                                               const Eigen::Matrix3d& rotation, double cell_m, std::size_t peaks);
+                                               const Eigen::Matrix3d& rotation, double cell_m, std::size_t peaks,
+                                               int separation_cells = 1);
 
 }  // namespace k4reg
