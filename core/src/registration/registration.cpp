@@ -18,6 +18,7 @@
 #include "k4reg/registration/four_pcs.h"
 #include "k4reg/registration/free_space.h"
 #include "k4reg/registration/icp.h"
+#include "k4reg/registration/metrics.h"
 #include "k4reg/geometry/neighbor_grid.h"
 #include "k4reg/registration/pose_score.h"
 #include "k4reg/geometry/rigid_fit.h"
@@ -186,8 +187,7 @@ bool repeats_under_a_shift(const std::vector<Hypothesis>& hypotheses, double min
   for (std::size_t i = 0; i < leading.size(); ++i)
     for (std::size_t j = i + 1; j < leading.size(); ++j) {
       const Eigen::Matrix4d &a = *leading[i], &b = *leading[j];
-      const Eigen::Matrix3d r = a.topLeftCorner<3, 3>().transpose() * b.topLeftCorner<3, 3>();
-      const double angle_deg = std::acos(std::clamp((r.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / M_PI;
+      const double angle_deg = rotation_angle_deg(a.topLeftCorner<3, 3>().transpose() * b.topLeftCorner<3, 3>());
       if (angle_deg < kSameRotationDeg && (a.topRightCorner<3, 1>() - b.topRightCorner<3, 1>()).norm() > min_shift_m)
         return true;
     }
