@@ -141,6 +141,10 @@ std::vector<Suite> all_suites(const fs::path& data, const std::string& cache) {
       simulated("courtyard", 0, {0, 1, 2, 3}, 700000, 0.1, 0.1, 0.4, "held-out", cache),
       simulated("hall", 3, {0, 1, 2, 4}, 700000, 0.05, 0.1, 0.4, "held-out", cache),
       simulated("object", 2, {0, 1, 2, 3, 4, 5, 6, 7, 8, 9}, 40000, 0.001, 0.002, 0.5, "held-out", cache),
+      // Added unseen with the loop-implied poses (issue 21): reported as first run.
+      simulated("monument", 4, {0, 1, 2}, 700000, 0.1, 0.1, 0.4, "held-out", cache),
+      simulated("hall", 4, {0, 1, 2, 4}, 700000, 0.05, 0.1, 0.4, "held-out", cache),
+      simulated("courtyard", 1, {0, 1, 2, 3}, 700000, 0.1, 0.1, 0.4, "held-out", cache),
       simulated("courtyard", 0, stations_up_to(6), 1000000, 0.1, 0.1, 0.4, "scaling", cache),
       simulated("courtyard", 0, stations_up_to(12), 1000000, 0.1, 0.1, 0.4, "scaling", cache),
       simulated("courtyard", 0, stations_up_to(24), 1000000, 0.1, 0.1, 0.4, "scaling", cache),

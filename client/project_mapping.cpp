@@ -40,6 +40,8 @@ ProjectResult project_result_from_proto(const v1::ProjectResult& m) {
     link.min_scale_m_used = l.min_scale_m_used();
     link.overlap_used = l.overlap_used();
     link.seconds = l.seconds();
+    link.judged_loop_poses = l.judged_loop_poses();
+    link.loop_pose_won = l.loop_pose_won();
     r.links.push_back(std::move(link));
   }
   r.reference = m.reference();

@@ -51,7 +51,9 @@ nlohmann::json project_to_json(const ProjectResult& r, const std::vector<ScanOri
                           {"candidate", l.candidate},
                           {"min_scale_m_used", l.min_scale_m_used},
                           {"overlap_used", l.overlap_used},
-                          {"seconds", l.seconds}});
+                          {"seconds", l.seconds},
+                          {"judged_loop_poses", l.judged_loop_poses},
+                          {"loop_pose_won", l.loop_pose_won}});
   j["reference"] = r.reference;
   j["scans_registered"] = r.scans_registered;
   j["loops_checked"] = r.loops_checked;

@@ -70,6 +70,8 @@ void project_result_to_proto(const ProjectResult& r, const std::vector<std::stri
     out.set_min_scale_m_used(l.min_scale_m_used);
     out.set_overlap_used(l.overlap_used);
     out.set_seconds(l.seconds);
+    out.set_judged_loop_poses(static_cast<std::uint32_t>(l.judged_loop_poses));
+    out.set_loop_pose_won(l.loop_pose_won);
   }
   m->set_reference(static_cast<std::uint32_t>(r.reference));
   m->set_scans_registered(static_cast<std::uint32_t>(r.scans_registered));

@@ -147,5 +147,29 @@ TEST(LoopClosure, PoorlySupportedWinnersVouchForNothing) {
   for (std::size_t l : {0, 1, 3}) EXPECT_EQ(r.links[l].verdict, LinkVerdict::kConfirmed) << l;
 }
 
+// Two true, well-supported links around an open loop imply the truth for the third, which its own 4PCS
+// missed; a closed loop, or one whose other links are not well supported, implies nothing.
+TEST(LoopClosure, OpenLoopsImplyTheirLinksPosesFromTheOtherTwo) {
+  const Project p;
+  std::vector<LinkCandidates> links = p.all_pairs();
+  links[1].transforms = {kFlip * p.relative(0, 2)};  // 0 -> 2: no true candidate
+  const LoopSelectionResult selection = select_loop_consistent(links, p.radius);
+  const std::vector<std::vector<Eigen::Matrix4d>> implied = poses_implied_by_open_loops(links, selection, p.radius);
+  ASSERT_EQ(implied.size(), links.size());
+  // 0 -> 2 lies in triangles 0-1-2 and 0-2-3, each of which implies the truth once (then it is known).
+  ASSERT_EQ(implied[1].size(), 1u);
+  EXPECT_LT(displacement_m(rigid_inverse(p.relative(0, 2)) * implied[1][0], 10.0), 1e-9);
+  // The other links of those open triangles are offered poses made with the flip, never the truth they have.
+  for (std::size_t l : {0, 3, 2, 5})
+    for (const Eigen::Matrix4d& pose : implied[l]) EXPECT_GT(displacement_m(rigid_inverse(p.relative(links[l].source, links[l].target)) * pose, 10.0), 1.0);
+  EXPECT_TRUE(implied[4].empty());  // 1 -> 3: its triangle 1-2-3 closes
+
+  const auto closed = poses_implied_by_open_loops(p.all_pairs(), select_loop_consistent(p.all_pairs(), p.radius), p.radius);
+  for (const auto& poses : closed) EXPECT_TRUE(poses.empty());
+
+  for (std::size_t l : {0, 2, 3, 5}) links[l].well_supported = false;  // every partner of 0 -> 2 in doubt
+  EXPECT_TRUE(poses_implied_by_open_loops(links, selection, p.radius)[1].empty());
+}
+
 }  // namespace
 }  // namespace k4reg

@@ -8,6 +8,7 @@
 #include "k4reg/geometry/rigid_motion.h"
 #include "k4reg/io/cloud_io.h"
 #include "k4reg/io/gt_pairs.h"
+#include "k4reg/project/pair_runner.h"
 #include "k4reg/project/project_registration.h"
 #include "k4reg/util/error.h"
 
@@ -122,6 +123,57 @@ TEST(ProjectRegistration, ScanOfAnotherObjectIsNotRegisteredAndTheRestStill) {
       EXPECT_FALSE(l.accepted);
       EXPECT_FALSE(l.reason.empty());
     }
+}
+
+// Registers each pair here, but one pair's 4PCS "misses" its truth: its hypotheses are replaced by the
+// truth turned half about the target's y axis through its centroid, as a well-supported, confident winner.
+class MissingTruthRunner : public PairRunner {
+ public:
+  MissingTruthRunner(ScanPair missed) : missed_(missed) {}
+  void run(const std::vector<PreparedScan>& scans, const std::vector<ScanPair>& pairs, const RegistrationParams& params,
+           const CancellationToken* cancel, const Done& done) override {
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      PairOutcome outcome = register_pair(scans[pairs[k].first], scans[pairs[k].second], params, cancel);
+      if (pairs[k] == missed_ && outcome.result) {
+        const PointCloud& target = scans[pairs[k].second].cloud();
+        Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+        for (const Eigen::Vector3f& p : target.points) centre += p.cast<double>();
+        centre = centre / static_cast<double>(target.size()) + target.origin_m;
+        Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
+        turn.topLeftCorner<3, 3>() = rotation_exp(Eigen::Vector3d(0, 3.14159265, 0));
+        turn.topRightCorner<3, 1>() = centre - turn.topLeftCorner<3, 3>() * centre;
+        RegistrationResult& r = *outcome.result;
+        r.transform = turn * r.transform;
+        r.hypotheses.resize(1);
+        r.hypotheses[0].transform = r.transform;
+        r.ambiguous = false;
+        r.ambiguity_margin = 0.5;
+        r.well_supported = true;
+      }
+      done(k, std::move(outcome));
+    }
+  }
+
+ private:
+  ScanPair missed_;
+};
+
+TEST(ProjectRegistration, PoseTheLoopsImplyReplacesAPairsConfidentWrongWinner) {
+  const BunnyProject bunny;
+  const std::vector<PointCloud> scans{bunny.scans[0], bunny.scans[1], bunny.scans[4]};  // bun000, bun045, bun315
+  MissingTruthRunner runner({0, 2});
+  const ProjectResult r = register_project(scans, statue_params(), nullptr, {}, {}, &runner);
+  ASSERT_EQ(r.links.size(), 3u);
+  const ProjectLink& fixed = r.links[1];  // 0 -> 2
+  EXPECT_GE(fixed.judged_loop_poses, 1u);
+  EXPECT_TRUE(fixed.loop_pose_won);
+  EXPECT_TRUE(fixed.accepted) << fixed.reason;
+  EXPECT_NE(fixed.reason.find("loops implied"), std::string::npos) << fixed.reason;
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_TRUE(r.scans[i].registered) << i << ": " << r.scans[i].reason;
+    EXPECT_LT(rms_error_m(scans[i], r.scans[i].pose, bunny.truth[i == 2 ? 4 : i]), 0.001) << i;
+  }
+  EXPECT_TRUE(std::any_of(r.timings.begin(), r.timings.end(), [](const StageTiming& t) { return t.stage == "loop_poses"; }));
 }
 
 TEST(ProjectRegistration, SameResultAtAnyThreadCount) {

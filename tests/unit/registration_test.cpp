@@ -2,6 +2,7 @@
 // geometric signal), survey-sized coordinates, determinism, cancellation and every error case.
 #include "k4reg/registration/registration.h"
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <gtest/gtest.h>
 
@@ -17,6 +18,7 @@
 #include "error_code_of.h"
 #include "k4reg/io/gt_pairs.h"
 #include "k4reg/registration/metrics.h"
+#include "k4reg/registration/prepared_scan.h"
 
 namespace k4reg {
 namespace {
@@ -58,6 +60,37 @@ TEST(Registration, BunnyTenHighestOverlapPairs) {
     }
   }
   EXPECT_GE(successes, 8);
+}
+
+// The poses a project's loops imply are judged as the pair's own hypotheses are: the true pose wins over a
+// half-turned one, whichever is given first, and the result carries the same figures.
+TEST(Registration, JudgedPosesPickTheTrueOneOnTheCloudsEvidence) {
+  const GtPair pair = bunny_pair("bun045.ply", "bun000.ply");
+  const PointCloud source = read_cloud(kBunny + pair.source), target = read_cloud(kBunny + pair.target);
+  const PreparedScan from(source), to(target);
+  Eigen::Matrix4d turned = Eigen::Matrix4d::Identity();
+  turned.topLeftCorner<3, 3>() = Eigen::AngleAxisd(3.14159265, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const Eigen::Matrix4d wrong = pair.T_target_source * turned;
+  // 2 degrees and 5 mm off: what a pose composed of two pairwise results may carry.
+  Eigen::Matrix4d nudge = Eigen::Matrix4d::Identity();
+  nudge.topLeftCorner<3, 3>() = Eigen::AngleAxisd(0.035, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  nudge(0, 3) = 0.005;
+  const Eigen::Matrix4d near_truth = nudge * pair.T_target_source;
+  const RegistrationParams params = bunny_params(0.9);
+  for (const std::vector<Eigen::Matrix4d>& poses : {std::vector{wrong, near_truth}, std::vector{near_truth, wrong}}) {
+    const RegistrationResult r = judge_poses(from, to, params, poses);
+    const TransformError e = transform_error(source.points, r.transform, pair.T_target_source);
+    EXPECT_LT(e.rmse_m, 0.001);
+    EXPECT_TRUE(r.well_supported);
+    EXPECT_FALSE(r.ambiguous) << r.ambiguity_reason;
+    EXPECT_GE(r.hypotheses.size(), 2u);
+    EXPECT_DOUBLE_EQ(r.min_scale_m_used, params.min_scale_m);
+    EXPECT_DOUBLE_EQ(r.overlap_used, params.overlap);
+  }
+  RegistrationParams automatic = params;
+  automatic.min_scale_m = 0.0;
+  EXPECT_EQ(test::error_code_of([&] { judge_poses(from, to, automatic, {wrong}); }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(test::error_code_of([&] { judge_poses(from, to, params, {}); }), ErrorCode::kInvalidArgument);
 }
 
 TEST(Registration, ResultCarriesTheEvidence) {

@@ -60,5 +60,32 @@ TEST(ScanConflicts, DoubtfulOrAcceptedOrSmallMisfitsRefuseNothing) {
   }
 }
 
+// A scan held by one link while three of its accepted links lead to refused scans is refused, and so is one
+// that the refusal leaves in the minority in turn; a scan whose links mostly lead to placed scans stays.
+TEST(ScanConflicts, ScansPlacedOnAMinorityOfTheirLinksAreRefused) {
+  ProjectResult r;
+  r.scans.resize(7);
+  for (ProjectScan& s : r.scans) s.registered = true;
+  for (std::size_t refused : {4, 5, 6}) r.scans[refused].registered = false;
+  // 0-1, 1-2, 0-2 placed together; 3 held by 0 only, its other links to the refused 4, 5, 6; 2 also links to 3.
+  for (auto [s, t] : {std::pair{0, 1}, {1, 2}, {0, 2}, {0, 3}, {3, 4}, {3, 5}, {3, 6}, {2, 3}}) {
+    ProjectLink link;
+    link.source = s, link.target = t, link.accepted = true;
+    r.links.push_back(link);
+    r.scans[s].links.push_back(r.links.size() - 1);
+    r.scans[t].links.push_back(r.links.size() - 1);
+  }
+  refuse_minority_placements(r);
+  EXPECT_TRUE(r.scans[0].registered && r.scans[1].registered && r.scans[2].registered);
+  EXPECT_FALSE(r.scans[3].registered);  // 2 of its 5 links lead to placed scans
+  EXPECT_NE(r.scans[3].reason.find("3 of its 5 accepted links"), std::string::npos) << r.scans[3].reason;
+
+  // Now 2 has links to 1, 0 and the refused 3: still a majority. Take 1 away and it is left with 1 of 3.
+  r.scans[1].registered = false;
+  refuse_minority_placements(r);
+  EXPECT_FALSE(r.scans[2].registered);
+  EXPECT_TRUE(r.scans[0].registered);  // the reference stays
+}
+
 }  // namespace
 }  // namespace k4reg

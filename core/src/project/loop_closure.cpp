@@ -43,7 +43,55 @@ std::vector<Triangle> find_triangles(const std::vector<LinkCandidates>& links) {
   return triangles;
 }
 
+// A triangle's residual (metres of displacement where it starts) and tolerance with the candidates `picks`.
+std::pair<double, double> loop_residual(const std::vector<LinkCandidates>& links, const Triangle& tri,
+                                        const std::array<int, 3>& picks, const std::vector<double>& scan_radius_m) {
+  Eigen::Matrix4d loop = Eigen::Matrix4d::Identity();
+  double tolerance_sq = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const LinkCandidates& link = links[tri.link[k]];
+    const Eigen::Matrix4d& t = link.transforms[picks[k]];
+    loop = (tri.inverted[k] ? rigid_inverse(t) : t) * loop;
+    tolerance_sq += link.tolerance_m * link.tolerance_m;
+  }
+  return {displacement_m(loop, scan_radius_m.at(tri.start)), kLoopToleranceFactor * std::sqrt(tolerance_sq)};
+}
+
 }  // namespace
+
+std::vector<std::vector<Eigen::Matrix4d>> poses_implied_by_open_loops(const std::vector<LinkCandidates>& links,
+                                                                     const LoopSelectionResult& selection,
+                                                                     const std::vector<double>& scan_radius_m) {
+  auto pick = [&](std::size_t l) {
+    return selection.links.at(l).candidate >= 0 ? selection.links[l].candidate : links[l].transforms.empty() ? -1 : 0;
+  };
+  std::vector<std::vector<Eigen::Matrix4d>> implied(links.size());
+  auto known = [&](std::size_t l, const Eigen::Matrix4d& pose) {
+    const double tolerance = kLoopToleranceFactor * links[l].tolerance_m, radius = scan_radius_m.at(links[l].source);
+    auto near = [&](const Eigen::Matrix4d& t) { return displacement_m(rigid_inverse(t) * pose, radius) <= tolerance; };
+    return std::any_of(links[l].transforms.begin(), links[l].transforms.end(), near) ||
+           std::any_of(implied[l].begin(), implied[l].end(), near);
+  };
+  for (const Triangle& tri : find_triangles(links)) {
+    const std::array<int, 3> picks{pick(tri.link[0]), pick(tri.link[1]), pick(tri.link[2])};
+    if (std::any_of(picks.begin(), picks.end(), [](int c) { return c < 0; })) continue;
+    if (const auto [r, tol] = loop_residual(links, tri, picks, scan_radius_m); r <= tol) continue;
+    // Each step of the walk as it is taken; a closed walk has step k = (step k+2 * step k+1)^-1.
+    std::array<Eigen::Matrix4d, 3> step;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Matrix4d& t = links[tri.link[k]].transforms[picks[k]];
+      step[k] = tri.inverted[k] ? rigid_inverse(t) : t;
+    }
+    for (int k = 0; k < 3; ++k) {
+      // Only two links whose pairwise winners are well supported imply a pose worth judging.
+      if (!links[tri.link[(k + 1) % 3]].well_supported || !links[tri.link[(k + 2) % 3]].well_supported) continue;
+      const Eigen::Matrix4d walked = rigid_inverse(step[(k + 2) % 3] * step[(k + 1) % 3]);
+      const Eigen::Matrix4d pose = tri.inverted[k] ? rigid_inverse(walked) : walked;
+      if (!known(tri.link[k], pose)) implied[tri.link[k]].push_back(pose);
+    }
+  }
+  return implied;
+}
 
 const char* to_string(LinkVerdict verdict) {
   switch (verdict) {
@@ -71,16 +119,7 @@ LoopSelectionResult select_loop_consistent(const std::vector<LinkCandidates>& li
   // A triangle's residual and tolerance with the candidates `picks` on its three links.
   using Picks = std::array<int, 3>;
   auto loop_residual = [&](const Triangle& tri, const Picks& picks) {
-    Eigen::Matrix4d loop = Eigen::Matrix4d::Identity();
-    double tolerance_sq = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      const LinkCandidates& link = links[tri.link[k]];
-      const Eigen::Matrix4d& t = link.transforms[picks[k]];
-      loop = (tri.inverted[k] ? rigid_inverse(t) : t) * loop;
-      tolerance_sq += link.tolerance_m * link.tolerance_m;
-    }
-    return std::make_pair(displacement_m(loop, scan_radius_m.at(tri.start)),
-                          kLoopToleranceFactor * std::sqrt(tolerance_sq));
+    return k4reg::loop_residual(links, tri, picks, scan_radius_m);
   };
   // Whether the closed loop vouches for its link `self` (see the header); links confirmed by other loops
   // count as certain.

@@ -196,11 +196,49 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
       for (const StageTiming& t : outcomes[k].result->timings) add_timing(r.timings, t.stage, t.seconds);
   }
 
-  // 2. One candidate per link, so that the loops close.
+  // 2. One candidate per link, so that the loops close. Where a loop stays open, the pose its other two links
+  //    imply for a link is judged on the link's own clouds (the pair's 4PCS may have missed the truth), and the
+  //    loops choose again.
   auto start = Clock::now();
   if (progress) progress("selection", 0.0);
   std::vector<double> radius(scans.size());
   for (std::size_t i = 0; i < scans.size(); ++i) radius[i] = scan_radius_m(scans[i]);
+  const LoopSelectionResult first = select_loop_consistent(candidates, radius);
+  const std::vector<std::vector<Eigen::Matrix4d>> implied = poses_implied_by_open_loops(candidates, first, radius);
+  add_timing(r.timings, "selection", seconds_since(start));
+  start = Clock::now();
+  for (std::size_t l = 0; l < r.links.size(); ++l) {
+    if (implied[l].empty()) continue;
+    check(&budget);
+    if (progress) progress("selection", static_cast<double>(l) / r.links.size());  // judging is part of it
+    const auto [s, t] = pairs[l];
+    RegistrationParams judge = pairwise;
+    judge.min_scale_m = r.links[l].min_scale_m_used;
+    judge.overlap = r.links[l].overlap_used;
+    // The winner and the implied poses (the runner-ups already lost to the winner on these clouds).
+    std::vector<Eigen::Matrix4d> poses{candidates[l].transforms.front()};
+    poses.insert(poses.end(), implied[l].begin(), implied[l].end());
+    PairOutcome outcome;
+    const auto judge_start = Clock::now();
+    try {
+      outcome.result = judge_poses(prepared[s], prepared[t], judge, poses, &budget);
+    } catch (const Error& e) {
+      if (e.code() == ErrorCode::kCancelled || e.code() == ErrorCode::kDeadlineExceeded) throw;
+    }
+    outcome.seconds = r.links[l].seconds + seconds_since(judge_start);
+    r.links[l].judged_loop_poses = implied[l].size();
+    // The pair's own result stands unless an implied pose, refined, beats its winner on its clouds.
+    if (!outcome.result) continue;
+    const double tolerance = kLoopToleranceFactor * candidates[l].tolerance_m;
+    auto near = [&](const Eigen::Matrix4d& a) {
+      return displacement_m(rigid_inverse(a) * outcome.result->transform, radius[pairs[l].first]) <= tolerance;
+    };
+    if (near(candidates[l].transforms.front()) || std::none_of(implied[l].begin(), implied[l].end(), near)) continue;
+    candidates[l] = link_from_outcome(outcome, pairs[l], r.links[l]);
+    r.links[l].loop_pose_won = true;
+  }
+  add_timing(r.timings, "loop_poses", seconds_since(start));
+  start = Clock::now();
   const LoopSelectionResult selection = select_loop_consistent(candidates, radius);
   r.loops_checked = selection.loops_checked;
   r.loops_inconsistent = selection.loops_inconsistent;
@@ -217,8 +255,9 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     if (link.accepted) link.transform = candidates[l].transforms[s.candidate];
     switch (s.verdict) {
       case LinkVerdict::kConfirmed:
-        link.reason = fmt::format("closes {} of its {} loops{}", s.loops_closed, s.loops,
-                                  s.candidate > 0 ? fmt::format(" with pairwise hypothesis {}, not the winner", s.candidate) : "");
+        link.reason = fmt::format("closes {} of its {} loops{}{}", s.loops_closed, s.loops,
+                                  s.candidate > 0 ? fmt::format(" with pairwise hypothesis {}, not the winner", s.candidate) : "",
+                                  link.loop_pose_won ? ", with a pose its loops implied that its clouds support better than the pairwise winner" : "");
         break;
       case LinkVerdict::kConsistent:
         link.reason = fmt::format("closes its {} loops, though none alone tells it from a symmetric twin", s.loops);
@@ -268,6 +307,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     }
     // Scans that a confident pairwise result contradicts leave the project (scan_conflicts.h).
     refuse_conflicted_scans(r, radius);
+    refuse_minority_placements(r);
     // Scans held too weakly to tell from a symmetric twin leave the project, with their links.
     std::vector<WeightedLink> weighted;
     for (std::size_t l : used) weighted.push_back({r.links[l].source, r.links[l].target, strength_weight(r.links[l])});

@@ -30,4 +30,25 @@ void refuse_conflicted_scans(ProjectResult& r, const std::vector<double>& scan_r
     }
 }
 
+void refuse_minority_placements(ProjectResult& r) {
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::size_t i = 0; i < r.scans.size(); ++i) {
+      ProjectScan& scan = r.scans[i];
+      if (!scan.registered || i == r.reference) continue;
+      std::size_t held = 0;
+      for (std::size_t l : scan.links) {
+        const ProjectLink& link = r.links[l];
+        held += r.scans[link.source == i ? link.target : link.source].registered;
+      }
+      if (2 * held > scan.links.size()) continue;
+      scan.registered = false;
+      scan.reason = fmt::format(
+          "placed on a minority of its evidence: {} of its {} accepted links lead to scans the project refused", scan.links.size() - held,
+          scan.links.size());
+      changed = true;
+    }
+  }
+}
+
 }  // namespace k4reg

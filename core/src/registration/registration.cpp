@@ -276,9 +276,19 @@ struct ScaleAttempt {
   bool supported = false;
 };
 
-// The single-scale pipeline, steps 1-5, at minimum scale sigma.
+// The inverse of to_file_frames.
+Eigen::Matrix4d to_local_frames(const Eigen::Matrix4d& file, const Eigen::Vector3d& source_origin,
+                                const Eigen::Vector3d& target_origin) {
+  Eigen::Matrix4d t = file;
+  t.topRightCorner<3, 1>() -= target_origin - file.topLeftCorner<3, 3>() * source_origin;
+  return t;
+}
+
+// The single-scale pipeline, steps 1-5, at minimum scale sigma. Given poses (files' frames) replace steps 2-3:
+// the symmetry guard and the verdict judge them instead of what 4PCS would find.
 ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedScan& target_scan,
-                               const RegistrationParams& params, double sigma, const CancellationToken* cancel,
+                               const RegistrationParams& params, double sigma,
+                               const std::vector<Eigen::Matrix4d>& given_poses, const CancellationToken* cancel,
                                const ProgressCallback& progress) {
   const PointCloud &source = source_scan.cloud(), &target = target_scan.cloud();
   RegistrationResult result;
@@ -403,7 +413,21 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   std::optional<Error> failure;
   int bases = 0;
   std::size_t rounds_run = 0;
-  for (std::size_t round = 0; round < overlaps.size(); ++round) {
+  if (!given_poses.empty()) {
+    CoarseAlignment& judged = chosen.emplace();
+    judged.signal = "given";
+    judged.overlap = overlaps.front();
+    std::vector<Hypothesis> hypotheses(given_poses.size());
+    for (std::size_t i = 0; i < given_poses.size(); ++i)
+      hypotheses[i].transform = to_local_frames(given_poses[i], source.origin_m, target.origin_m);
+    const auto& icp = icp_pyramids();
+    judged.guarded = timer.run("symmetry_guard", [&] {
+      return rank_hypotheses(icp.first, icp.second, std::move(hypotheses), judged.overlap, free_space ? &views : nullptr,
+                             params.levelled, cancel);
+    });
+    rounds_run = 1;
+  }
+  for (std::size_t round = 0; round < overlaps.size() && given_poses.empty(); ++round) {
     ++rounds_run;
     // Round 0 keeps the caller's seed; later rounds draw fresh bases.
     const std::uint64_t seed = params.seed + 0x9E3779B97F4A7C15ULL * round;
@@ -494,10 +518,12 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
     in_file_frame(h.base_source_m, source.origin_m);
     in_file_frame(h.base_target_m, target.origin_m);
   }
-  for (const Eigen::Vector3f& p : *chosen->source_points)
-    result.source_keypoint_positions_m.push_back(p.cast<double>() + source.origin_m);
-  for (const Eigen::Vector3f& p : *chosen->target_points)
-    result.target_keypoint_positions_m.push_back(p.cast<double>() + target.origin_m);
+  if (chosen->source_points)
+    for (const Eigen::Vector3f& p : *chosen->source_points)
+      result.source_keypoint_positions_m.push_back(p.cast<double>() + source.origin_m);
+  if (chosen->target_points)
+    for (const Eigen::Vector3f& p : *chosen->target_points)
+      result.target_keypoint_positions_m.push_back(p.cast<double>() + target.origin_m);
   result.well_supported = on_the_surface && best.refined_score >= needed;
   const bool supported = result.well_supported;
   return {std::move(result), supported};
@@ -561,7 +587,7 @@ RegistrationResult run(const PreparedScan& source, const PreparedScan& target, c
   for (double sigma = ladder.start_m(); sigma > 0.0; sigma = ladder.next(sigma, tried)) {
     ++tried;
     try {
-      ScaleAttempt attempt = register_at_scale(source, target, params, sigma, cancel, progress);
+      ScaleAttempt attempt = register_at_scale(source, target, params, sigma, {}, cancel, progress);
       add_timings(timings, attempt.result.timings);
       // The first well-supported pose stands; failing one, the best supported of all scales tried.
       const double support = attempt.result.hypotheses.front().refined_score;
@@ -585,6 +611,19 @@ RegistrationResult run(const PreparedScan& source, const PreparedScan& target, c
 RegistrationResult register_clouds(const PointCloud& source, const PointCloud& target, const RegistrationParams& params,
                                    const CancellationToken* cancel, const ProgressCallback& progress) {
   return register_clouds(PreparedScan(source), PreparedScan(target), params, cancel, progress);
+}
+
+RegistrationResult judge_poses(const PreparedScan& source, const PreparedScan& target, const RegistrationParams& params,
+                               const std::vector<Eigen::Matrix4d>& poses, const CancellationToken* cancel) {
+  validate(params);
+  if (params.min_scale_m == 0.0 || params.overlap == 0.0)
+    fail(ErrorCode::kInvalidArgument, "judging given poses needs the scale and the overlap they were found at");
+  if (poses.empty()) fail(ErrorCode::kInvalidArgument, "no poses to judge");
+  if (source.cloud().empty() || target.cloud().empty()) fail(ErrorCode::kInvalidArgument, "a cloud is empty");
+  tbb::task_arena arena(params.threads > 0 ? params.threads : tbb::task_arena::automatic);
+  RegistrationResult result;
+  arena.execute([&] { result = register_at_scale(source, target, params, params.min_scale_m, poses, cancel, {}).result; });
+  return result;
 }
 
 RegistrationResult register_clouds(const PreparedScan& source, const PreparedScan& target,

@@ -67,6 +67,15 @@ constexpr double kLoopToleranceFactor = 3.0;
 LoopSelectionResult select_loop_consistent(const std::vector<LinkCandidates>& links,
                                            const std::vector<double>& scan_radius_m);
 
+// Per link, the poses (source -> target) that its open triangles imply: where a triangle does not close with
+// the chosen candidates (a rejected link's pairwise winner standing in for it), the other two links' choices
+// composed, where both of those links' pairwise winners are well supported. A pair's 4PCS may miss its true pose, which two true links around a loop give; the pair's own
+// clouds must then judge it (judge_poses), since a loop always closes with a link made from its other two.
+// Poses within a link's tolerance of one of its candidates, or of one already implied, are left out.
+std::vector<std::vector<Eigen::Matrix4d>> poses_implied_by_open_loops(const std::vector<LinkCandidates>& links,
+                                                                     const LoopSelectionResult& selection,
+                                                                     const std::vector<double>& scan_radius_m);
+
 const char* to_string(LinkVerdict verdict);
 
 }  // namespace k4reg

@@ -1,13 +1,15 @@
 // Project registration: N scans into one frame (after Theiler, Wegner, Schindler 2015), top to bottom:
 //   candidate pairs (candidate_pairs.h)  ->  pairwise K-4PCS per pair, keeping its distinct hypotheses
-//   ->  loop-consistent selection of one hypothesis per link (loop_closure.h)  ->  initial poses by
-//   consensus of the accepted links, from the reference out  ->  each scan's strength (scan_strength.h)
-//   ->  global refinement (pose_graph.h), where a link that disagrees with the refined project is dropped
-//   and the rest solved again.
+//   ->  loop-consistent selection of one hypothesis per link (loop_closure.h)  ->  where a loop stays open,
+//   the poses its links imply judged on each link's own clouds (judge_poses), and the selection again
+//   ->  initial poses by consensus of the accepted links, from the reference out  ->  conflicts, minority
+//   placements (scan_conflicts.h) and each scan's strength (scan_strength.h)  ->  global refinement
+//   (pose_graph.h), where a link that disagrees with the refined project is dropped and the rest solved again.
 // A scan that no majority of accepted links places, or that they hold too weakly to tell it from a
 // symmetric twin, is reported as not registered, never forced into place. Pairs run one after the other, each on all
 // threads (or wherever a PairRunner sends them), so the result is the same at any thread count and on any runner.
-// Cost: one pairwise registration per candidate pair (0.2-3 s each at 1 M points on 2 cores); selection and
+// Cost: one pairwise registration per candidate pair (0.2-3 s each at 1 M points on 2 cores); judging implied
+// poses, a guard and a verdict per link in an open loop of well-supported links (0.1-1 s each); selection and
 // refinement take milliseconds.
 #pragma once
 
@@ -42,6 +44,10 @@ struct ProjectLink {
   bool ambiguous = false, well_supported = false;
   double min_scale_m_used = 0.0, overlap_used = 0.0;
   std::size_t hypotheses = 0;  // distinct candidates the pairwise registration kept
+  // Poses its open loops implied that its own clouds judged alongside its hypotheses (loop_closure.h), and
+  // whether one of them won: the figures above are then that judgement's, else the pairwise result's.
+  std::size_t judged_loop_poses = 0;
+  bool loop_pose_won = false;
   int candidate = -1;          // the one chosen (0 = the pairwise winner), -1 = none
   bool accepted = false;
   std::string verdict;  // confirmed, unchecked, contradicted, unresolved, failed, inconsistent

@@ -17,4 +17,11 @@ namespace k4reg {
 // radius about its frame's origin (weighs a rotation misfit, as in the loops).
 void refuse_conflicted_scans(ProjectResult& result, const std::vector<double>& scan_radius_m);
 
+// Scans placed on a minority of their own evidence: where most of a registered scan's accepted links lead to
+// scans the project refused, the few that placed it may be the wrong side of a conflict the others would have
+// shown (a symmetric object's back views, placed flipped by their flipped links to the front while their
+// true links go to refused neighbours). Refused until none is left (each refusal may leave another in the
+// minority); the reference stays. Cost: O(scans x links) per round.
+void refuse_minority_placements(ProjectResult& result);
+
 }  // namespace k4reg
