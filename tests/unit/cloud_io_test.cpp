@@ -163,6 +163,17 @@ TEST_F(CloudIoTest, XyzRoundTripEveryStyle) {
   }
 }
 
+// 3DTK's .3d scans (the Kurt3D robot's): a first line with the sweep size, then x y z per line. The size line
+// is skipped only first; later, or with another word than "x", it is an error naming the line.
+TEST_F(CloudIoTest, ThreeDtkScanSkipsItsSweepSizeLine) {
+  const PointCloud c = read_cloud(write_file("scan000.3d", "360 x 225\n10.1 0 0\n10.0996 -0.0662149 0.0581712\n1 2 3\n"));
+  ASSERT_EQ(c.size(), 3u);
+  EXPECT_NEAR(c.points[1].x() + c.origin_m.x(), 10.0996, 1e-5);
+  EXPECT_FALSE(c.has_intensity());
+  expect_error([&] { read_cloud(write_file("late.3d", "1 2 3\n360 x 225\n")); }, ErrorCode::kInvalidArgument, "late.3d", "line 2");
+  expect_error([&] { read_cloud(write_file("by.3d", "360 by 225\n1 2 3\n")); }, ErrorCode::kInvalidArgument, "by.3d", "line 1");
+}
+
 TEST_F(CloudIoTest, WriteCloudPicksFormatFromExtension) {
   const PointCloud c = small_cloud(true, true);
   const std::pair<const char*, CloudFormat> cases[] = {

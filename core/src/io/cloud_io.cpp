@@ -268,7 +268,7 @@ bool extension_format(const std::string& path, CloudFormat& format) {
     format = CloudFormat::kPly;
   } else if (ext == ".pcd") {
     format = CloudFormat::kPcd;
-  } else if (ext == ".xyz" || ext == ".txt" || ext == ".pts" || ext == ".csv" || ext == ".asc") {
+  } else if (ext == ".xyz" || ext == ".txt" || ext == ".pts" || ext == ".csv" || ext == ".asc" || ext == ".3d") {
     format = CloudFormat::kXyz;
   } else if (ext == ".las" || ext == ".laz") {  // the LAS reader refuses compressed (LAZ) content
     format = CloudFormat::kLas;

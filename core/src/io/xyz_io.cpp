@@ -34,9 +34,14 @@ PointCloud read_xyz_bytes(std::string_view data, const std::string& name, const 
     if (tokens.size() > io_detail::kMaxTokensPerLine)
       fail_io(ErrorCode::kInvalidArgument, name,
               "line " + std::to_string(ln) + ": more than " + std::to_string(io_detail::kMaxTokensPerLine) + " columns");
-    std::uint64_t count_line;
+    std::uint64_t count_line, rows;
     if (tokens.size() == 1 && io_detail::parse_uint64(tokens[0], count_line)) {  // PTS point count
       seen_content = true;
+      continue;
+    }
+    if (!seen_content && tokens.size() == 3 && (tokens[1] == "x" || tokens[1] == "X") &&
+        io_detail::parse_uint64(tokens[0], count_line) && io_detail::parse_uint64(tokens[2], rows)) {
+      seen_content = true;  // a 3DTK scan's sweep size, "360 x 225"
       continue;
     }
     double values[4] = {0, 0, 0, 0};

@@ -30,17 +30,17 @@ double PoseScorer::score(const Eigen::Matrix4d& t) const {
   return cloud_score(scored_, reference_, *reference_.grid, tau_, t, views_, overlap_);
 }
 
-double PoseScorer::surface_agreement(const Eigen::Matrix4d& t) const {
+double surface_agreement(const std::vector<Eigen::Vector3f>& points, const Eigen::Matrix4d& t,
+                         const IcpPyramid::Stage& reference) {
   const Eigen::Matrix3f r = t.topLeftCorner<3, 3>().cast<float>();
   const Eigen::Vector3f shift = t.topRightCorner<3, 1>().cast<float>();
-  const auto voxel = static_cast<float>(finest_reference_.voxel_m);
-  const auto& reference = finest_reference_;
+  const auto voxel = static_cast<float>(reference.voxel_m);
   // Integer counts: the same for any split over threads.
   const auto [near, on] = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, finest_.size(), 4096), std::pair<std::size_t, std::size_t>{0, 0},
+      tbb::blocked_range<std::size_t>(0, points.size(), 4096), std::pair<std::size_t, std::size_t>{0, 0},
       [&](const tbb::blocked_range<std::size_t>& range, std::pair<std::size_t, std::size_t> c) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          const Eigen::Vector3f q = r * finest_[i] + shift;
+          const Eigen::Vector3f q = r * points[i] + shift;
           const int k = reference.grid->nearest_within(q, kNearVoxels * voxel);
           if (k < 0 || reference.normals[k].isZero()) continue;
           ++c.first;
@@ -52,6 +52,10 @@ double PoseScorer::surface_agreement(const Eigen::Matrix4d& t) const {
         return std::pair<std::size_t, std::size_t>{a.first + b.first, a.second + b.second};
       });
   return near > 0 ? static_cast<double>(on) / static_cast<double>(near) : 0.0;
+}
+
+double PoseScorer::surface_agreement(const Eigen::Matrix4d& t) const {
+  return k4reg::surface_agreement(finest_, t, finest_reference_);
 }
 
 }  // namespace k4reg

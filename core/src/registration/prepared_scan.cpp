@@ -1,5 +1,7 @@
 #include "k4reg/registration/prepared_scan.h"
 
+#include "k4reg/registration/pose_score.h"
+
 #include <map>
 #include <mutex>
 #include <tuple>
@@ -48,6 +50,7 @@ struct PreparedScan::Cache {
   Entries<std::tuple<double, int, double>, Pyramid> pyramids;  // sigma, stages, distance factor
   Entries<std::tuple<double, int, bool, int, int, double>, ScanKeypoints> keypoints;  // sigma, signal, DoG
   Entries<double, FreeSpaceImage> free_space;
+  Entries<double, double> self_agreement;
 };
 
 PreparedScan::PreparedScan(const PointCloud& cloud) : cloud_(&cloud), cache_(std::make_unique<Cache>()) {}
@@ -90,6 +93,19 @@ const ScanKeypoints& PreparedScan::keypoints(double sigma_m, KeypointSignal sign
 const FreeSpaceImage& PreparedScan::free_space(double margin_m) const {
   return cache_->free_space.get(margin_m,
                                 [&] { return FreeSpaceImage(cloud_->points, scanner_position(*cloud_), margin_m); });
+}
+
+double PreparedScan::surface_self_agreement(double sigma_m, const CancellationToken* cancel) const {
+  return cache_->self_agreement.get(sigma_m, [&] {
+    PointCloud halves[2];
+    for (std::size_t i = 0; i < cloud_->size(); ++i) halves[i % 2].points.push_back(cloud_->points[i]);
+    IcpParams one_stage;
+    one_stage.voxel_m = sigma_m;
+    one_stage.stages = 1;
+    const IcpPyramid surface = make_icp_pyramid(voxel_grid(halves[0], sigma_m, cancel).cloud.points, one_stage, true, cancel);
+    const std::vector<Eigen::Vector3f> other = every_kth(voxel_grid(halves[1], sigma_m, cancel).cloud.points, 30000);
+    return surface_agreement(other, Eigen::Matrix4d::Identity(), surface.stages.front());
+  });
 }
 
 }  // namespace k4reg

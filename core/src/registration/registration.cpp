@@ -194,6 +194,28 @@ bool repeats_under_a_shift(const std::vector<Hypothesis>& hypotheses, double min
   return false;
 }
 
+// The surface agreement a refined pose needs to count as lying on the target surface: kMinSurfaceAgreement of
+// what the target's own two halves reach (no pose can do better than two samplings of one surface). On clean
+// scans they reach 0.99 or more, so the bar is kMinSurfaceAgreement itself; noise or clutter at the scale
+// lowers both (a 2D scanner swept through an office, cm noise at a 5 cm scale: 0.75). Measured only for a
+// pose under kMinSurfaceAgreement.
+class SurfaceBar {
+ public:
+  SurfaceBar(const PreparedScan& target, double sigma_m, const CancellationToken* cancel)
+      : target_(target), sigma_m_(sigma_m), cancel_(cancel) {}
+  bool passes(double agreement) const { return agreement >= kMinSurfaceAgreement || agreement >= required(); }
+  double required() const {
+    if (required_ < 0.0) required_ = kMinSurfaceAgreement * target_.surface_self_agreement(sigma_m_, cancel_);
+    return required_;
+  }
+
+ private:
+  const PreparedScan& target_;
+  double sigma_m_;
+  const CancellationToken* cancel_;
+  mutable double required_ = -1.0;
+};
+
 // The verdict on the guard's ranking: the leading hypotheses refined fully and judged again.
 struct Verdict {
   std::vector<Hypothesis> hypotheses;  // the winner first, the other contenders after it, the rest as they were
@@ -203,8 +225,8 @@ struct Verdict {
 };
 
 Verdict judge_contenders(const SymmetryGuardResult& guarded, const IcpPyramid& source, const IcpPyramid& target,
-                         const IcpParams& final_params, const PoseScorer& scorer, bool icp, double sigma,
-                         StageTimer& timer, const CancellationToken* cancel) {
+                         const IcpParams& final_params, const PoseScorer& scorer, const SurfaceBar& bar, bool icp,
+                         double sigma, StageTimer& timer, const CancellationToken* cancel) {
   Verdict verdict;
   verdict.hypotheses = guarded.hypotheses;
   verdict.margin = guarded.ambiguity_margin;
@@ -246,7 +268,7 @@ Verdict judge_contenders(const SymmetryGuardResult& guarded, const IcpPyramid& s
   });
   // A pose off the target surface cannot be the true one, however well supported: contenders on the
   // surface rank first, then by support (unrefined poses, with --no-icp, are not judged on the surface).
-  auto on_surface = [&](std::size_t i) { return !icp || hypotheses[i].surface_agreement >= kMinSurfaceAgreement; };
+  auto on_surface = [&](std::size_t i) { return !icp || bar.passes(hypotheses[i].surface_agreement); };
   std::stable_sort(kept.begin(), kept.end(), [&](std::size_t a, std::size_t b) {
     if (on_surface(a) != on_surface(b)) return on_surface(a);
     return hypotheses[a].refined_score > hypotheses[b].refined_score;
@@ -459,8 +481,9 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   IcpParams final_params = icp_params;
   if (!params.icp) final_params.max_iterations = 0;  // quality figures only, at the finest stage
   const PoseScorer scorer(icp.first, icp.second, free_space ? &views : nullptr, result.overlap_used);
+  const SurfaceBar bar(target_scan, sigma, cancel);
   auto judge = [&](const SymmetryGuardResult& guarded) {
-    return judge_contenders(guarded, icp.first, icp.second, final_params, scorer, params.icp, sigma, timer, cancel);
+    return judge_contenders(guarded, icp.first, icp.second, final_params, scorer, bar, params.icp, sigma, timer, cancel);
   };
   Verdict verdict = judge(chosen->guarded);
   // Where the verdict cannot decide and the hypotheses show the scene repeating under a shift (a corridor's
@@ -496,7 +519,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
     result.ambiguity_reason = fmt::format(
         "off the surface: once refined, {:.0f} % of the source points near the target lie on its surface (true "
         "poses: {:.0f} % or more)",
-        100 * best.surface_agreement, 100 * kMinSurfaceAgreement);
+        100 * best.surface_agreement, 100 * bar.required());
   } else if (best.refined_score < needed) {
     result.ambiguous = true;
     result.ambiguity_reason = fmt::format(

@@ -58,7 +58,7 @@ CloudFormat detect_format(const std::string& path);
 // error messages.
 CloudFormat detect_format_bytes(std::string_view data, const std::string& name);
 
-// Format from the extension only (.ply, .pcd, .xyz/.txt/.pts/.csv/.asc, .las, .ptx, .e57; case-insensitive).
+// Format from the extension only (.ply, .pcd, .xyz/.txt/.pts/.csv/.asc/.3d, .las, .ptx, .e57; case-insensitive).
 // kInvalidArgument for anything else, and for .laz ("LAZ is not supported; decompress with laszip or pdal
 // first").
 CloudFormat format_from_extension(const std::string& path);

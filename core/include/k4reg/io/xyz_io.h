@@ -1,9 +1,10 @@
-// Plain-text point lists: .xyz / .txt / .csv / .pts. See cloud_io.h for the common contract.
+// Plain-text point lists: .xyz / .txt / .csv / .pts / .asc / .3d (3DTK). See cloud_io.h for the common contract.
 //
 // One point per line: `x y z [intensity] [more columns…]`, separated by whitespace and/or commas.
 // - Blank lines and comment lines starting with '#' or '//' are skipped.
 // - A line holding a single integer is a point-count line (Leica PTS; also between scans of a
 //   multi-scan PTS file) and is skipped.
+// - A first line `W x H` (3DTK's .3d scans: the sweep's columns and rows) is skipped.
 // - One header line made only of non-numeric words (e.g. "x,y,z,intensity") is skipped if it is the
 //   first non-comment line; anywhere else a non-numeric token is an error naming the line.
 // - All data lines must have the same number of columns (the first data line decides); a mismatch is an

@@ -21,6 +21,11 @@
 
 namespace k4reg {
 
+// Of `points` under t that come within two voxels of the reference stage's surface, the share that lie on it
+// (point-to-plane within half a voxel); 0 when none come near. reference: a target stage (grid and normals).
+double surface_agreement(const std::vector<Eigen::Vector3f>& points, const Eigen::Matrix4d& t,
+                         const IcpPyramid::Stage& reference);
+
 class PoseScorer {
  public:
   // Pyramids in local frames, with at least two stages; views may be null (no free-space test).

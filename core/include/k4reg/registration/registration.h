@@ -85,7 +85,9 @@ struct Hypothesis {
   std::vector<Eigen::Vector3d> base_source_m, base_target_m;
 };
 
-// A refined pose with less surface agreement than this is not taken as well supported.
+// A refined pose with less surface agreement than this share of what the target's own two halves reach
+// (PreparedScan::surface_self_agreement: 0.99 or more on clean scans, less on noisy ones) is not taken as well
+// supported.
 constexpr double kMinSurfaceAgreement = 0.75;
 
 // Below this margin between the best pose and the runner-up, the result is flagged ambiguous.
