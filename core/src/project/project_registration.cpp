@@ -268,7 +268,9 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
                                   candidates[l].transforms.size(), s.loops, s.loop_residual_m);
         break;
       case LinkVerdict::kUnresolved:
-        link.reason = "ambiguous pairwise result in no loop that could resolve it";
+        link.reason = s.loops == 0 ? "ambiguous pairwise result in no loop that could resolve it"
+                                   : fmt::format("ambiguous pairwise result whose {} loops do not all close, and none vouches for it",
+                                                 s.loops);
         break;
       case LinkVerdict::kFailed: break;
     }

@@ -38,7 +38,7 @@ enum class LinkVerdict {
                   // how firmly it holds its scans is left to scan_strength.h
   kUnchecked,     // in no loop; accepted on its pairwise verdict (unambiguous)
   kContradicted,  // closes no vouching loop, and an open loop blames it: rejected
-  kUnresolved,    // ambiguous pairwise and in no loop: rejected
+  kUnresolved,    // ambiguous pairwise, and no loop resolves it (in none, or its loops stay open unblamed): rejected
   kFailed,        // pairwise registration found no candidate
 };
 
