@@ -171,5 +171,28 @@ TEST(LoopClosure, OpenLoopsImplyTheirLinksPosesFromTheOtherTwo) {
   EXPECT_TRUE(poses_implied_by_open_loops(links, selection, p.radius)[1].empty());
 }
 
+// A scan turned against all the others closes every loop: here scan 1, by the runner-up of its confident
+// true link to scan 0 and the confident wrong winner of its link to scan 2 (the monument's back station and
+// its front-side neighbour). The winners do not close, so they imply the truth for each link whose truth
+// neither hypothesis has, to be judged on that pair's clouds.
+TEST(LoopClosure, LoopsClosedOnlyThroughARunnerUpImplyWhatTheWinnersGive) {
+  const Project p;
+  const Eigen::Matrix4d turned = kFlip * p.relative(0, 1);  // scan 1 half-turned in scan 0's frame
+  std::vector<LinkCandidates> links{{0, 1, {p.relative(0, 1), turned}, 0.05, false, 0.08, true},
+                                    {0, 2, {p.relative(0, 2)}, 0.05, false, 0.3, true},
+                                    {1, 2, {p.relative(0, 2) * rigid_inverse(turned)}, 0.05, false, 0.9, true}};
+  const LoopSelectionResult selection = select_loop_consistent(links, p.radius);
+  ASSERT_EQ(selection.links[0].candidate, 1);  // the loop closes through the runner-up
+  const std::vector<std::vector<Eigen::Matrix4d>> implied = poses_implied_by_open_loops(links, selection, p.radius);
+  ASSERT_EQ(implied[2].size(), 1u);
+  EXPECT_LT(displacement_m(rigid_inverse(p.relative(1, 2)) * implied[2][0], 10.0), 1e-9);
+  EXPECT_TRUE(implied[0].empty());  // what the other two winners imply for 0 -> 1 is its runner-up: known
+  EXPECT_EQ(implied[1].size(), 1u);  // 0 -> 2 is offered the turned pose, for its clouds to reject
+
+  links[2].transforms = {p.relative(1, 2)};  // the winners close: nothing to imply
+  const LoopSelectionResult closed = select_loop_consistent(links, p.radius);
+  for (const auto& poses : poses_implied_by_open_loops(links, closed, p.radius)) EXPECT_TRUE(poses.empty());
+}
+
 }  // namespace
 }  // namespace k4reg

@@ -125,6 +125,17 @@ TEST(ProjectRegistration, ScanOfAnotherObjectIsNotRegisteredAndTheRestStill) {
     }
 }
 
+// A half turn about the y axis through the cloud's centroid (in its frame): a symmetric object's flip.
+Eigen::Matrix4d half_turn_about_centroid(const PointCloud& cloud) {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3f& p : cloud.points) centre += p.cast<double>();
+  centre = centre / static_cast<double>(cloud.size()) + cloud.origin_m;
+  Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
+  turn.topLeftCorner<3, 3>() = rotation_exp(Eigen::Vector3d(0, 3.14159265, 0));
+  turn.topRightCorner<3, 1>() = centre - turn.topLeftCorner<3, 3>() * centre;
+  return turn;
+}
+
 // Registers each pair here, but one pair's 4PCS "misses" its truth: its hypotheses are replaced by the
 // truth turned half about the target's y axis through its centroid, as a well-supported, confident winner.
 class MissingTruthRunner : public PairRunner {
@@ -135,13 +146,7 @@ class MissingTruthRunner : public PairRunner {
     for (std::size_t k = 0; k < pairs.size(); ++k) {
       PairOutcome outcome = register_pair(scans[pairs[k].first], scans[pairs[k].second], params, cancel);
       if (pairs[k] == missed_ && outcome.result) {
-        const PointCloud& target = scans[pairs[k].second].cloud();
-        Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-        for (const Eigen::Vector3f& p : target.points) centre += p.cast<double>();
-        centre = centre / static_cast<double>(target.size()) + target.origin_m;
-        Eigen::Matrix4d turn = Eigen::Matrix4d::Identity();
-        turn.topLeftCorner<3, 3>() = rotation_exp(Eigen::Vector3d(0, 3.14159265, 0));
-        turn.topRightCorner<3, 1>() = centre - turn.topLeftCorner<3, 3>() * centre;
+        const Eigen::Matrix4d turn = half_turn_about_centroid(scans[pairs[k].second].cloud());
         RegistrationResult& r = *outcome.result;
         r.transform = turn * r.transform;
         r.hypotheses.resize(1);
@@ -174,6 +179,50 @@ TEST(ProjectRegistration, PoseTheLoopsImplyReplacesAPairsConfidentWrongWinner) {
     EXPECT_LT(rms_error_m(scans[i], r.scans[i].pose, bunny.truth[i == 2 ? 4 : i]), 0.001) << i;
   }
   EXPECT_TRUE(std::any_of(r.timings.begin(), r.timings.end(), [](const StageTiming& t) { return t.stage == "loop_poses"; }));
+}
+
+// Registers each pair here, but places scan 1 half-turned about its centroid against scan 2 as a confident
+// winner, and against scan 0 as the runner-up of the true winner: the loop closes through that runner-up (a
+// scan turned against all the others closes every loop), as the monument's back station did with its
+// front-side neighbour.
+class TurnedScanRunner : public PairRunner {
+ public:
+  void run(const std::vector<PreparedScan>& scans, const std::vector<ScanPair>& pairs, const RegistrationParams& params,
+           const CancellationToken* cancel, const Done& done) override {
+    const Eigen::Matrix4d turn = half_turn_about_centroid(scans[1].cloud());  // in scan 1's frame
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      PairOutcome outcome = register_pair(scans[pairs[k].first], scans[pairs[k].second], params, cancel);
+      if (outcome.result && pairs[k] == ScanPair{0, 1}) {
+        RegistrationResult& r = *outcome.result;
+        r.hypotheses.resize(2);
+        r.hypotheses[1] = r.hypotheses[0];
+        r.hypotheses[1].transform = rigid_inverse(turn) * r.transform;
+        r.ambiguity_margin = 0.08;
+      } else if (outcome.result && pairs[k] == ScanPair{1, 2}) {
+        RegistrationResult& r = *outcome.result;
+        r.transform = r.transform * turn;
+        r.hypotheses.resize(1);
+        r.hypotheses[0].transform = r.transform;
+        r.ambiguous = false;
+        r.ambiguity_margin = 0.9;
+        r.well_supported = true;
+      }
+      done(k, std::move(outcome));
+    }
+  }
+};
+
+TEST(ProjectRegistration, ScanTurnedAgainstAllOthersIsPlacedByWhatTheWinnersImply) {
+  const BunnyProject bunny;
+  const std::vector<PointCloud> scans(bunny.scans.begin(), bunny.scans.begin() + 3);
+  TurnedScanRunner runner;
+  const ProjectResult r = register_project(scans, statue_params(), nullptr, {}, {}, &runner);
+  ASSERT_EQ(r.links.size(), 3u);
+  EXPECT_TRUE(r.links[2].loop_pose_won) << r.links[2].reason;  // 1 -> 2: the pose scans 0's links imply
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_TRUE(r.scans[i].registered) << i << ": " << r.scans[i].reason;
+    EXPECT_LT(rms_error_m(scans[i], r.scans[i].pose, bunny.truth[i]), 0.001) << i;
+  }
 }
 
 TEST(ProjectRegistration, SameResultAtAnyThreadCount) {

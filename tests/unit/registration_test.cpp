@@ -87,9 +87,15 @@ TEST(Registration, JudgedPosesPickTheTrueOneOnTheCloudsEvidence) {
     EXPECT_DOUBLE_EQ(r.min_scale_m_used, params.min_scale_m);
     EXPECT_DOUBLE_EQ(r.overlap_used, params.overlap);
   }
+  // An automatic scale is judged at the scale register_clouds starts from.
   RegistrationParams automatic = params;
   automatic.min_scale_m = 0.0;
-  EXPECT_EQ(test::error_code_of([&] { judge_poses(from, to, automatic, {wrong}); }), ErrorCode::kInvalidArgument);
+  const RegistrationResult judged = judge_poses(from, to, automatic, {wrong, near_truth});
+  EXPECT_LT(transform_error(source.points, judged.transform, pair.T_target_source).rmse_m, 0.001);
+  EXPECT_DOUBLE_EQ(judged.min_scale_m_used, register_clouds(source, target, automatic).min_scale_m_used);
+  RegistrationParams no_overlap = params;
+  no_overlap.overlap = 0.0;
+  EXPECT_EQ(test::error_code_of([&] { judge_poses(from, to, no_overlap, {wrong}); }), ErrorCode::kInvalidArgument);
   EXPECT_EQ(test::error_code_of([&] { judge_poses(from, to, params, {}); }), ErrorCode::kInvalidArgument);
 }
 

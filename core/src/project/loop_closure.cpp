@@ -72,11 +72,8 @@ std::vector<std::vector<Eigen::Matrix4d>> poses_implied_by_open_loops(const std:
     return std::any_of(links[l].transforms.begin(), links[l].transforms.end(), near) ||
            std::any_of(implied[l].begin(), implied[l].end(), near);
   };
-  for (const Triangle& tri : find_triangles(links)) {
-    const std::array<int, 3> picks{pick(tri.link[0]), pick(tri.link[1]), pick(tri.link[2])};
-    if (std::any_of(picks.begin(), picks.end(), [](int c) { return c < 0; })) continue;
-    if (const auto [r, tol] = loop_residual(links, tri, picks, scan_radius_m); r <= tol) continue;
-    // Each step of the walk as it is taken; a closed walk has step k = (step k+2 * step k+1)^-1.
+  // Each step of the walk as it is taken; a closed walk has step k = (step k+2 * step k+1)^-1.
+  auto imply = [&](const Triangle& tri, const std::array<int, 3>& picks) {
     std::array<Eigen::Matrix4d, 3> step;
     for (int k = 0; k < 3; ++k) {
       const Eigen::Matrix4d& t = links[tri.link[k]].transforms[picks[k]];
@@ -89,6 +86,20 @@ std::vector<std::vector<Eigen::Matrix4d>> poses_implied_by_open_loops(const std:
       const Eigen::Matrix4d pose = tri.inverted[k] ? rigid_inverse(walked) : walked;
       if (!known(tri.link[k], pose)) implied[tri.link[k]].push_back(pose);
     }
+  };
+  auto closes = [&](const Triangle& tri, const std::array<int, 3>& picks) {
+    const auto [r, tol] = loop_residual(links, tri, picks, scan_radius_m);
+    return r <= tol;
+  };
+  for (const Triangle& tri : find_triangles(links)) {
+    const std::array<int, 3> picks{pick(tri.link[0]), pick(tri.link[1]), pick(tri.link[2])};
+    if (std::any_of(picks.begin(), picks.end(), [](int c) { return c < 0; })) continue;
+    if (!closes(tri, picks)) imply(tri, picks);
+    // A loop closed through a runner-up while the pairwise winners do not close: the runner-up may be a
+    // symmetric twin that closes with another link's confident wrong winner (a scan turned against all the
+    // others closes every loop). The winners then imply a pose for that link, to be judged too.
+    const std::array<int, 3> winners{0, 0, 0};
+    if (picks != winners && !closes(tri, winners)) imply(tri, winners);
   }
   return implied;
 }

@@ -69,7 +69,8 @@ LoopSelectionResult select_loop_consistent(const std::vector<LinkCandidates>& li
 
 // Per link, the poses (source -> target) that its open triangles imply: where a triangle does not close with
 // the chosen candidates (a rejected link's pairwise winner standing in for it), the other two links' choices
-// composed, where both of those links' pairwise winners are well supported. A pair's 4PCS may miss its true pose, which two true links around a loop give; the pair's own
+// composed, where both of those links' pairwise winners are well supported; and where it closes only through a
+// runner-up while the pairwise winners do not close, the other two links' winners composed. A pair's 4PCS may miss its true pose, which two true links around a loop give; the pair's own
 // clouds must then judge it (judge_poses), since a loop always closes with a link made from its other two.
 // Poses within a link's tolerance of one of its candidates, or of one already implied, are left out.
 std::vector<std::vector<Eigen::Matrix4d>> poses_implied_by_open_loops(const std::vector<LinkCandidates>& links,

@@ -152,7 +152,9 @@ RegistrationResult register_clouds(const PreparedScan& source, const PreparedSca
 // Judges given poses (source -> target, files' frames) as register_clouds judges the hypotheses it finds, at
 // one scale: the symmetry guard (which adds their symmetric twins), the leading poses' full refinement and
 // the verdict, with the same figures and flags. For poses found elsewhere: a project's loops propose poses a
-// pair's own 4PCS missed. params.min_scale_m and params.overlap must be set (the pair's own scale and overlap).
+// pair's own 4PCS missed. At params.min_scale_m, or where it is 0 at the scale register_clouds starts from
+// (not at a finer scale a pair may have stepped down to: there the tolerances are finer than the sampling of
+// far surfaces, and a true pose can score 0.34); params.overlap must be set.
 // Cost: the guard and the verdict of one registration, without keypoints or 4PCS.
 RegistrationResult judge_poses(const PreparedScan& source, const PreparedScan& target, const RegistrationParams& params,
                                const std::vector<Eigen::Matrix4d>& poses, const CancellationToken* cancel = nullptr);
