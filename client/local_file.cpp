@@ -2,8 +2,10 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 
 #include "command_error.h"
+#include "k4reg/util/crc32c.h"
 
 namespace k4reg::cli {
 namespace {
@@ -35,6 +37,21 @@ std::string read_local_file(const std::string& path) {
   FileReader reader(path, 1 << 20);
   for (const std::string* piece = &reader.next(); !piece->empty(); piece = &reader.next()) bytes += *piece;
   return bytes;
+}
+
+LocalFile describe_local_file(const std::string& path) {
+  LocalFile file{path, {}};
+  FileReader reader(path, kUploadChunkBytes);
+  Crc32c crc;
+  std::uint64_t size = 0;
+  for (const std::string* piece = &reader.next(); !piece->empty(); piece = &reader.next()) {
+    crc.update(*piece);
+    size += piece->size();
+  }
+  file.description.set_file_name(std::filesystem::path(path).filename().string());  // format hint, no local paths
+  file.description.set_size_bytes(size);
+  file.description.set_crc32c(crc.value());
+  return file;
 }
 
 }  // namespace k4reg::cli

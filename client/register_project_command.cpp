@@ -35,19 +35,20 @@ struct RegisterProjectOptions {
   ReportFlags report;
 };
 
-v1::RegisterProjectRequest make_request(const RegisterProjectOptions& o, ProjectParams& params) {
+// The header names every scan: a path on the server (--ref) or a local file whose chunks follow.
+v1::ProjectUploadHeader make_header(const RegisterProjectOptions& o, ProjectParams& params, std::vector<LocalFile>& uploads) {
   apply_pairs(o.flags, params);
-  v1::RegisterProjectRequest request;
+  v1::ProjectUploadHeader header;
   for (const std::string& scan : o.scans) {
-    v1::CloudInput& input = *request.add_scans();
+    v1::StreamCloud& cloud = *header.add_scans();
     if (o.by_reference) {
-      input.set_path(scan);
+      cloud.set_path(scan);
     } else {
-      input.mutable_inline_cloud()->set_data(read_local_file(scan));  // within the server's --max-inline-mb
-      input.mutable_inline_cloud()->set_file_name(scan);
+      uploads.push_back(describe_local_file(scan));  // every file checked before connecting: a typo costs no upload
+      *cloud.mutable_upload() = uploads.back().description;
     }
   }
-  v1::ProjectParams& p = *request.mutable_params();
+  v1::ProjectParams& p = *header.mutable_params();
   *p.mutable_pairwise() = params_to_proto(params.pairwise, o.registration);
   if (o.flags.reference->count() > 0) p.set_reference(static_cast<std::uint32_t>(params.reference));
   p.set_pairs(params.pairs == PairSelection::kAll        ? v1::PAIR_SELECTION_ALL
@@ -58,23 +59,43 @@ v1::RegisterProjectRequest make_request(const RegisterProjectOptions& o, Project
     pair.set_first(static_cast<std::uint32_t>(first));
     pair.set_second(static_cast<std::uint32_t>(second));
   }
-  return request;
+  return header;
 }
 
 void run_register_project(const RegisterProjectOptions& o) {
   ProjectParams params = o.params;
-  v1::RegisterProjectRequest request = make_request(o, params);
-  if (o.report.wanted()) request.set_preview_points(static_cast<std::uint32_t>(o.report.preview_points));
+  std::vector<LocalFile> uploads;
+  v1::RegisterProjectStreamRequest first;
+  *first.mutable_header() = make_header(o, params, uploads);
+  if (o.report.wanted()) first.mutable_header()->set_preview_points(static_cast<std::uint32_t>(o.report.preview_points));
   const auto channel = make_channel(o.connection);
   auto stub = v1::Registration::NewStub(channel);
   grpc::ClientContext context;
   add_call_metadata(context, o.connection, o.request_id.empty() ? new_request_id() : o.request_id);
   if (o.deadline_s > 0) context.set_deadline(deadline_after(o.deadline_s));
+  auto stream = stub->RegisterProjectStream(&context);
+  // A failed Write means the server ended the call (a refused path, say): its status says why.
+  bool open = stream->Write(first);
+  try {
+    for (std::size_t i = 0; i < uploads.size() && open; ++i) {
+      FileReader reader(uploads[i].path, kUploadChunkBytes);
+      for (const std::string* piece = &reader.next(); open && !piece->empty(); piece = &reader.next()) {
+        v1::RegisterProjectStreamRequest chunk;
+        chunk.mutable_chunk()->set_scan(static_cast<std::uint32_t>(i));
+        chunk.mutable_chunk()->set_data(*piece);
+        open = stream->Write(chunk);
+      }
+    }
+  } catch (const CommandError&) {
+    context.TryCancel();  // a file that became unreadable since it was checksummed: end the call first
+    stream->Finish();
+    throw;
+  }
+  if (open) stream->WritesDone();
   // Queue position and each finished pair on stderr, as align-project prints them; stdout stays the result.
   const bool watched = isatty(STDERR_FILENO);
   v1::RegisterProjectResponse response;
-  auto reader = stub->RegisterProject(&context, request);
-  for (v1::RegisterProjectEvent event; reader->Read(&event);) {
+  for (v1::RegisterProjectEvent event; stream->Read(&event);) {
     if (event.has_result()) response = event.result();
     if (!watched) continue;
     if (event.has_queued()) std::cerr << fmt::format("queued: {} jobs ahead\n", event.queued().position());
@@ -83,7 +104,7 @@ void run_register_project(const RegisterProjectOptions& o) {
       std::cerr << pair_line(pair.index(), pair.pairs(), pair.source(), pair.target(), pair.seconds(), pair.error()) << "\n";
     }
   }
-  if (const grpc::Status status = reader->Finish(); !status.ok())
+  if (const grpc::Status status = stream->Finish(); !status.ok())
     throw CommandError(describe_failure(status, *channel, o.connection.server));
 
   const ProjectResult result = project_result_from_proto(response.result());
@@ -114,8 +135,9 @@ void add_register_project_command(CLI::App& app) {
   auto options = std::make_shared<RegisterProjectOptions>();
   CLI::App* command = app.add_subcommand(
       "register-project",
-      "register a project of scans on a k4reg server: local files are sent inline (the server's --max-inline-mb\n"
-      "bounds them all together), or with --ref named on the server. Parameter flags not given are not sent.");
+      "register a project of scans on a k4reg server (RegisterProjectStream): local files are uploaded in 1 MiB\n"
+      "chunks (the server's --max-upload-mb bounds each), or with --ref named on the server. Parameter flags not\n"
+      "given are not sent.");
   command->add_option("SCAN", options->scans, "the scans: local files, or with --ref paths on the server")->required();
   add_connection_flags(*command, options->connection);
   options->registration = add_registration_flags(*command, options->params.pairwise);

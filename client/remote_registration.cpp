@@ -2,12 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
-#include <filesystem>
 #include <thread>
 #include <vector>
 
 #include "command_error.h"
-#include "k4reg/util/crc32c.h"
 #include "local_file.h"
 #include "status_text.h"
 
@@ -16,31 +14,8 @@ namespace {
 
 using Stream = grpc::ClientReaderWriter<v1::RegisterStreamRequest, v1::RegisterStreamResponse>;
 
-constexpr std::size_t kChunkBytes = 1 << 20;  // the protocol's maximum: fewest messages
 constexpr double kFirstBackoff_s = 1.0;       // gRPC's own reconnect backoff starts at 1 s
 constexpr double kMaxBackoff_s = 16.0;
-
-// Files are read twice, once here for the header's size and CRC-32C and once while sending, so a scan of any
-// size streams through a 1 MiB buffer instead of being held in memory.
-struct LocalFile {
-  std::string path;
-  v1::UploadedFile description;
-};
-
-LocalFile describe_local_file(const std::string& path) {
-  LocalFile file{path, {}};
-  FileReader reader(path, kChunkBytes);
-  Crc32c crc;
-  std::uint64_t size = 0;
-  for (const std::string* piece = &reader.next(); !piece->empty(); piece = &reader.next()) {
-    crc.update(*piece);
-    size += piece->size();
-  }
-  file.description.set_file_name(std::filesystem::path(path).filename().string());  // format hint, no local paths
-  file.description.set_size_bytes(size);
-  file.description.set_crc32c(crc.value());
-  return file;
-}
 
 class Attempt {
  public:
@@ -59,7 +34,7 @@ class Attempt {
     if (total > 0) observer_.on_upload(0, total);  // starts the clock of the upload rate
     try {
       for (const auto& [role, file] : uploads) {
-        FileReader reader(file.path, kChunkBytes);
+        FileReader reader(file.path, kUploadChunkBytes);
         for (const std::string* piece = &reader.next(); open && !piece->empty(); piece = &reader.next()) {
           v1::RegisterStreamRequest chunk;
           chunk.mutable_chunk()->set_role(role);

@@ -23,20 +23,26 @@ ProjectReactor::ProjectReactor(ServiceContext& service, grpc::CallbackServerCont
   start_job(*context, clock_, [this](Job& job) { execute(job); });
 }
 
-void ProjectReactor::execute(Job& job) {
-  const StageListener stages = [this](const std::string& stage, v1::StageEvent::Phase phase, double fraction) {
-    post_stage(stage, phase, fraction, clock_.job_start);
-  };
-  const PairListener pairs = [this](const ProjectLink& link, std::size_t index, std::size_t count) {
+grpc::Status run_project_call(const ServiceContext& service, Job& job, const ProjectJob& project, CallClock& clock,
+                              RequestRecord& record, const StageListener& stages,
+                              const std::function<void(v1::RegisterProjectEvent)>& post) {
+  const PairListener pairs = [&post](const ProjectLink& link, std::size_t index, std::size_t count) {
     v1::RegisterProjectEvent message;
     pair_event_to_proto(link, index, count, *message.mutable_pair());
     post(std::move(message));
   };
   v1::RegisterProjectEvent reply;
-  const grpc::Status status =
-      run_project_job(service_, job, project_, stages, pairs, clock_, record_, *reply.mutable_result());
+  const grpc::Status status = run_project_job(service, job, project, stages, pairs, clock, record, *reply.mutable_result());
   if (status.ok()) post(std::move(reply));
-  finish(status);
+  return status;
+}
+
+void ProjectReactor::execute(Job& job) {
+  const StageListener stages = [this](const std::string& stage, v1::StageEvent::Phase phase, double fraction) {
+    post_stage(stage, phase, fraction, clock_.job_start);
+  };
+  finish(run_project_call(service_, job, project_, clock_, record_, stages,
+                          [this](v1::RegisterProjectEvent event) { post(std::move(event)); }));
 }
 
 void ProjectReactor::on_finishing(const grpc::Status& status) {

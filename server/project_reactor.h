@@ -3,6 +3,7 @@
 // registered pair, and finally the result, through the outbox (job_stream_reactor.h).
 #pragma once
 
+#include <functional>
 #include <memory>
 
 #include "job_stream_reactor.h"
@@ -11,6 +12,12 @@
 #include "service_context.h"
 
 namespace k4reg::service {
+
+// A project call's job on a worker (RegisterProject, RegisterProjectStream): runs it, posting its stage and
+// pair events and, when it succeeds, the result; returns the call's status.
+grpc::Status run_project_call(const ServiceContext& service, Job& job, const ProjectJob& project, CallClock& clock,
+                              RequestRecord& record, const StageListener& stages,
+                              const std::function<void(v1::RegisterProjectEvent)>& post);
 
 class ProjectReactor final
     : public JobStreamReactor<grpc::ServerWriteReactor<v1::RegisterProjectEvent>, v1::RegisterProjectEvent> {

@@ -2,6 +2,7 @@
 
 #include "pair_reactor.h"
 #include "project_reactor.h"
+#include "project_stream_reactor.h"
 #include "register_reactor.h"
 #include "stream_reactor.h"
 
@@ -22,6 +23,11 @@ grpc::ServerBidiReactor<v1::RegisterStreamRequest, v1::RegisterStreamResponse>* 
 grpc::ServerWriteReactor<v1::RegisterProjectEvent>* RegistrationService::RegisterProject(
     grpc::CallbackServerContext* context, const v1::RegisterProjectRequest* request) {
   return new ProjectReactor(context_, context, request);
+}
+
+grpc::ServerBidiReactor<v1::RegisterProjectStreamRequest, v1::RegisterProjectEvent>*
+RegistrationService::RegisterProjectStream(grpc::CallbackServerContext* context) {
+  return new ProjectStreamReactor(context_, context);
 }
 
 grpc::ServerUnaryReactor* RegistrationService::RegisterPair(grpc::CallbackServerContext* context,

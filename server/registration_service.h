@@ -17,6 +17,8 @@ class RegistrationService final : public v1::Registration::CallbackService {
       grpc::CallbackServerContext* context) override;
   grpc::ServerWriteReactor<v1::RegisterProjectEvent>* RegisterProject(grpc::CallbackServerContext* context,
                                                                      const v1::RegisterProjectRequest* request) override;
+  grpc::ServerBidiReactor<v1::RegisterProjectStreamRequest, v1::RegisterProjectEvent>* RegisterProjectStream(
+      grpc::CallbackServerContext* context) override;
   grpc::ServerUnaryReactor* RegisterPair(grpc::CallbackServerContext* context, const v1::RegisterPairRequest* request,
                                          v1::RegisterPairResponse* reply) override;
 

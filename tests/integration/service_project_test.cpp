@@ -4,6 +4,7 @@
 
 #include "http_json.h"
 #include "k4reg/io/cloud_io.h"
+#include "k4reg/util/crc32c.h"
 #include "test_support.h"
 
 namespace k4reg::test {
@@ -182,6 +183,44 @@ TEST_F(ServiceProject, MalformedProjectsAreRefusedWithAReason) {
     const HttpReply reply = reply_of(http.Post("/v1/register-project", service::to_json(c.request), "application/json"));
     EXPECT_EQ(reply.status, c.http_status) << c.message << ": " << reply.body;
   }
+}
+
+// RegisterProjectStream (what `k4reg register-project` uploads with, above) checks every chunk against the
+// header: a chunk for a scan the header does not upload, or bytes whose CRC-32C differs, end the call.
+TEST_F(ServiceProject, StreamedUploadRefusesChunksItCannotPlace) {
+  const std::string bytes = read_file(bunny_dir() / "bun045.ply");
+  auto call = [&](std::uint32_t chunk_scan, std::uint32_t declared_crc) {
+    auto stub = server_->stub();
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::minutes(1));
+    auto stream = stub->RegisterProjectStream(&context);
+    v1::RegisterProjectStreamRequest header;
+    header.mutable_header()->add_scans()->set_path("bun000.ply");
+    v1::UploadedFile& upload = *header.mutable_header()->add_scans()->mutable_upload();
+    upload.set_file_name("bun045.ply");
+    upload.set_size_bytes(bytes.size());
+    upload.set_crc32c(declared_crc);
+    *header.mutable_header()->mutable_params() = project_params();
+    bool open = stream->Write(header);
+    for (std::size_t at = 0; open && at < bytes.size(); at += 1 << 20) {
+      v1::RegisterProjectStreamRequest chunk;
+      chunk.mutable_chunk()->set_scan(chunk_scan);
+      chunk.mutable_chunk()->set_data(bytes.substr(at, 1 << 20));
+      open = stream->Write(chunk);
+    }
+    if (open) stream->WritesDone();
+    for (v1::RegisterProjectEvent event; stream->Read(&event);) {
+    }
+    return stream->Finish();
+  };
+  const grpc::Status path_chunk = call(0, crc32c(bytes));
+  EXPECT_EQ(path_chunk.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << path_chunk.error_message();
+  EXPECT_NE(path_chunk.error_message().find("scan 0, which is not an upload"), std::string::npos) << path_chunk.error_message();
+  const grpc::Status beyond = call(2, crc32c(bytes));
+  EXPECT_EQ(beyond.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << beyond.error_message();
+  const grpc::Status corrupted = call(1, crc32c(bytes) ^ 1u);
+  EXPECT_EQ(corrupted.error_code(), grpc::StatusCode::DATA_LOSS) << corrupted.error_message();
+  EXPECT_NE(corrupted.error_message().find("scan 1 upload bun045.ply"), std::string::npos) << corrupted.error_message();
 }
 
 }  // namespace
