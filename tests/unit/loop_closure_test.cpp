@@ -194,5 +194,34 @@ TEST(LoopClosure, LoopsClosedOnlyThroughARunnerUpImplyWhatTheWinnersGive) {
   for (const auto& poses : poses_implied_by_open_loops(links, closed, p.radius)) EXPECT_TRUE(poses.empty());
 }
 
+// A pair's clouds judge its winner against the poses its loops implied: an implied pose that wins replaces it; one
+// the clouds cannot tell from the winner (within the ambiguity margin, second) makes the link a tie for the loops
+// to decide; otherwise the winner stands.
+TEST(LoopClosure, ImpliedPosesWinTieOrLoseOnThePairsClouds) {
+  const Project p;
+  const Eigen::Matrix4d truth = p.relative(0, 1), winner = kFlip * truth;
+  const LinkCandidates link{0, 1, {winner}, 0.05, false, 0.3, true};
+  auto judged = [&](const Eigen::Matrix4d& first, const Eigen::Matrix4d& second, double second_refined, double margin) {
+    RegistrationResult r;
+    r.transform = first;
+    r.hypotheses.resize(2);
+    r.hypotheses[0].transform = first;
+    r.hypotheses[0].refined_score = 0.998;
+    r.hypotheses[1].transform = second;
+    r.hypotheses[1].refined_score = second_refined;
+    r.ambiguity_margin = margin;
+    return r;
+  };
+  const Eigen::Matrix4d nudged = pose(0.001, {0.01, 0, 0}) * truth;  // refined a little away from the implied pose
+  EXPECT_EQ(judge_implied_poses(link, {truth}, judged(nudged, winner, 0.8, 0.2), p.radius), LoopPoseJudgement::kImpliedWon);
+  EXPECT_EQ(judge_implied_poses(link, {truth}, judged(winner, nudged, 0.997, 0.001), p.radius), LoopPoseJudgement::kTied);
+  EXPECT_EQ(judge_implied_poses(link, {truth}, judged(winner, nudged, 0.7, 0.3), p.radius), LoopPoseJudgement::kWinnerStands);
+  // A close runner-up that is not an implied pose (a twin the guard added) is no tie with the loops.
+  EXPECT_EQ(judge_implied_poses(link, {truth}, judged(winner, pose(2.0, {5, 5, 0}), 0.997, 0.001), p.radius),
+            LoopPoseJudgement::kWinnerStands);
+  // A runner-up not refined (outside the contender band) ties nothing.
+  EXPECT_EQ(judge_implied_poses(link, {truth}, judged(winner, nudged, 0.0, 0.001), p.radius), LoopPoseJudgement::kWinnerStands);
+}
+
 }  // namespace
 }  // namespace k4reg

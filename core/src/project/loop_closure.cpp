@@ -67,8 +67,7 @@ std::vector<std::vector<Eigen::Matrix4d>> poses_implied_by_open_loops(const std:
   };
   std::vector<std::vector<Eigen::Matrix4d>> implied(links.size());
   auto known = [&](std::size_t l, const Eigen::Matrix4d& pose) {
-    const double tolerance = kLoopToleranceFactor * links[l].tolerance_m, radius = scan_radius_m.at(links[l].source);
-    auto near = [&](const Eigen::Matrix4d& t) { return displacement_m(rigid_inverse(t) * pose, radius) <= tolerance; };
+    auto near = [&](const Eigen::Matrix4d& t) { return within_loop_tolerance(links[l], t, pose, scan_radius_m); };
     return std::any_of(links[l].transforms.begin(), links[l].transforms.end(), near) ||
            std::any_of(implied[l].begin(), implied[l].end(), near);
   };
@@ -102,6 +101,25 @@ std::vector<std::vector<Eigen::Matrix4d>> poses_implied_by_open_loops(const std:
     if (picks != winners && !closes(tri, winners)) imply(tri, winners);
   }
   return implied;
+}
+
+bool within_loop_tolerance(const LinkCandidates& link, const Eigen::Matrix4d& a, const Eigen::Matrix4d& b,
+                           const std::vector<double>& scan_radius_m) {
+  return displacement_m(rigid_inverse(a) * b, scan_radius_m.at(link.source)) <= kLoopToleranceFactor * link.tolerance_m;
+}
+
+LoopPoseJudgement judge_implied_poses(const LinkCandidates& link, const std::vector<Eigen::Matrix4d>& implied,
+                                      const RegistrationResult& judged, const std::vector<double>& scan_radius_m) {
+  auto implied_pose = [&](const Eigen::Matrix4d& t) {
+    return std::any_of(implied.begin(), implied.end(),
+                       [&](const Eigen::Matrix4d& p) { return within_loop_tolerance(link, p, t, scan_radius_m); });
+  };
+  if (link.transforms.empty() || judged.hypotheses.empty()) return LoopPoseJudgement::kWinnerStands;
+  if (implied_pose(judged.transform) && !within_loop_tolerance(link, link.transforms.front(), judged.transform, scan_radius_m))
+    return LoopPoseJudgement::kImpliedWon;
+  const bool tied = judged.ambiguity_margin < kAmbiguousMargin && judged.hypotheses.size() >= 2 &&
+                    judged.hypotheses[1].refined_score > 0 && implied_pose(judged.hypotheses[1].transform);
+  return tied ? LoopPoseJudgement::kTied : LoopPoseJudgement::kWinnerStands;
 }
 
 const char* to_string(LinkVerdict verdict) {

@@ -228,23 +228,13 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     outcome.seconds = r.links[l].seconds + seconds_since(judge_start);
     r.links[l].judged_loop_poses = implied[l].size();
     // The pair's own result stands unless an implied pose, refined, beats its winner on its clouds, or comes so
-    // close that the clouds cannot tell them apart (the pair's margin came from 4PCS missing that pose): then
-    // the judged result, flagged ambiguous, replaces it and the loops choose between the two.
+    // close that the clouds cannot tell them apart: then the judged result, flagged ambiguous, replaces it and
+    // the loops choose between the two.
     if (!outcome.result) continue;
-    const RegistrationResult& judged = *outcome.result;
-    const double tolerance = kLoopToleranceFactor * candidates[l].tolerance_m;
-    auto near = [&](const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
-      return displacement_m(rigid_inverse(a) * b, radius[pairs[l].first]) <= tolerance;
-    };
-    auto implied_pose = [&](const Eigen::Matrix4d& t) {
-      return std::any_of(implied[l].begin(), implied[l].end(), [&](const Eigen::Matrix4d& p) { return near(p, t); });
-    };
-    const bool won = implied_pose(judged.transform) && !near(candidates[l].transforms.front(), judged.transform);
-    const bool tied = judged.ambiguity_margin < kAmbiguousMargin && judged.hypotheses.size() >= 2 &&
-                      judged.hypotheses[1].refined_score > 0 && implied_pose(judged.hypotheses[1].transform);
-    if (!won && !tied) continue;
+    const LoopPoseJudgement judgement = judge_implied_poses(candidates[l], implied[l], *outcome.result, radius);
+    if (judgement == LoopPoseJudgement::kWinnerStands) continue;
     candidates[l] = link_from_outcome(outcome, pairs[l], r.links[l]);
-    r.links[l].loop_pose_won = won;
+    r.links[l].loop_pose_won = judgement == LoopPoseJudgement::kImpliedWon;
   }
   add_timing(r.timings, "loop_poses", seconds_since(start));
   start = Clock::now();

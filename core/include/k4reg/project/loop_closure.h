@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "k4reg/registration/registration.h"
+
 namespace k4reg {
 
 struct LinkCandidates {
@@ -70,12 +72,25 @@ LoopSelectionResult select_loop_consistent(const std::vector<LinkCandidates>& li
 // Per link, the poses (source -> target) that its open triangles imply: where a triangle does not close with
 // the chosen candidates (a rejected link's pairwise winner standing in for it), the other two links' choices
 // composed, where both of those links' pairwise winners are well supported; and where it closes only through a
-// runner-up while the pairwise winners do not close, the other two links' winners composed. A pair's 4PCS may miss its true pose, which two true links around a loop give; the pair's own
-// clouds must then judge it (judge_poses), since a loop always closes with a link made from its other two.
+// runner-up while the pairwise winners do not close, the other two links' winners composed. A pair's 4PCS may
+// miss its true pose, which two true links around a loop give; the pair's own clouds must then judge it
+// (judge_poses), since a loop always closes with a link made from its other two.
 // Poses within a link's tolerance of one of its candidates, or of one already implied, are left out.
 std::vector<std::vector<Eigen::Matrix4d>> poses_implied_by_open_loops(const std::vector<LinkCandidates>& links,
                                                                      const LoopSelectionResult& selection,
                                                                      const std::vector<double>& scan_radius_m);
+
+// Whether two poses of a link lie within three times its expected error of each other (displacement where its
+// source scan is).
+bool within_loop_tolerance(const LinkCandidates& link, const Eigen::Matrix4d& a, const Eigen::Matrix4d& b,
+                           const std::vector<double>& scan_radius_m);
+
+// What a pair's own clouds said of the poses its loops implied, from judge_poses' result on its winner and
+// them: the winner stands, an implied pose won, or the clouds cannot tell an implied pose (second, within the
+// ambiguity margin) from the winner, so the pair's own margin came from its 4PCS missing that pose.
+enum class LoopPoseJudgement { kWinnerStands, kImpliedWon, kTied };
+LoopPoseJudgement judge_implied_poses(const LinkCandidates& link, const std::vector<Eigen::Matrix4d>& implied,
+                                      const RegistrationResult& judged, const std::vector<double>& scan_radius_m);
 
 const char* to_string(LinkVerdict verdict);
 
