@@ -19,6 +19,7 @@
 #include "registration_flags.h"
 #include "server_timings.h"
 #include "status_text.h"
+#include "upload_stream.h"
 
 namespace k4reg::cli {
 namespace {
@@ -74,24 +75,15 @@ void run_register_project(const RegisterProjectOptions& o) {
   add_call_metadata(context, o.connection, o.request_id.empty() ? new_request_id() : o.request_id);
   if (o.deadline_s > 0) context.set_deadline(deadline_after(o.deadline_s));
   auto stream = stub->RegisterProjectStream(&context);
-  // A failed Write means the server ended the call (a refused path, say): its status says why.
-  bool open = stream->Write(first);
-  try {
-    for (std::size_t i = 0; i < uploads.size() && open; ++i) {
-      FileReader reader(uploads[i].path, kUploadChunkBytes);
-      for (const std::string* piece = &reader.next(); open && !piece->empty(); piece = &reader.next()) {
+  upload_files(
+      *stream, context, first, uploads,
+      [](std::size_t i, const std::string& piece) {
         v1::RegisterProjectStreamRequest chunk;
         chunk.mutable_chunk()->set_scan(static_cast<std::uint32_t>(i));
-        chunk.mutable_chunk()->set_data(*piece);
-        open = stream->Write(chunk);
-      }
-    }
-  } catch (const CommandError&) {
-    context.TryCancel();  // a file that became unreadable since it was checksummed: end the call first
-    stream->Finish();
-    throw;
-  }
-  if (open) stream->WritesDone();
+        chunk.mutable_chunk()->set_data(piece);
+        return chunk;
+      },
+      [](std::uint64_t, std::uint64_t) {});
   // Queue position and each finished pair on stderr, as align-project prints them; stdout stays the result.
   const bool watched = isatty(STDERR_FILENO);
   v1::RegisterProjectResponse response;

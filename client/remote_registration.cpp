@@ -8,6 +8,7 @@
 #include "command_error.h"
 #include "local_file.h"
 #include "status_text.h"
+#include "upload_stream.h"
 
 namespace k4reg::cli {
 namespace {
@@ -23,35 +24,19 @@ class Attempt {
       : context_(context), observer_(observer), stream_(stub.RegisterStream(&context)) {}
 
   // The call's status; `response` is set when it is OK.
-  grpc::Status run(const v1::UploadHeader& header, const std::vector<std::pair<v1::CloudRole, LocalFile>>& uploads,
-                   v1::RegisterResponse& response) {
-    v1::RegisterStreamRequest message;
-    *message.mutable_header() = header;
-    // A failed Write means the server ended the call (e.g. a refused path): its status says why.
-    bool open = stream_->Write(message);
-    std::uint64_t sent = 0, total = 0;
-    for (const auto& [role, file] : uploads) total += file.description.size_bytes();
-    if (total > 0) observer_.on_upload(0, total);  // starts the clock of the upload rate
-    try {
-      for (const auto& [role, file] : uploads) {
-        FileReader reader(file.path, kUploadChunkBytes);
-        for (const std::string* piece = &reader.next(); open && !piece->empty(); piece = &reader.next()) {
+  grpc::Status run(const v1::UploadHeader& header, const std::vector<LocalFile>& uploads,
+                   const std::vector<v1::CloudRole>& roles, v1::RegisterResponse& response) {
+    v1::RegisterStreamRequest first;
+    *first.mutable_header() = header;
+    upload_files(
+        *stream_, context_, first, uploads,
+        [&roles](std::size_t i, const std::string& piece) {
           v1::RegisterStreamRequest chunk;
-          chunk.mutable_chunk()->set_role(role);
-          chunk.mutable_chunk()->set_data(*piece);
-          open = stream_->Write(chunk);
-          if (!open) break;
-          sent += piece->size();
-          observer_.on_upload(sent, total);
-        }
-      }
-    } catch (const CommandError&) {
-      // A file that became unreadable since it was checksummed: end the call before reporting it.
-      context_.TryCancel();
-      finish(response);
-      throw;
-    }
-    if (open) stream_->WritesDone();
+          chunk.mutable_chunk()->set_role(roles[i]);
+          chunk.mutable_chunk()->set_data(piece);
+          return chunk;
+        },
+        [this](std::uint64_t sent, std::uint64_t total) { observer_.on_upload(sent, total); });
     return finish(response);
   }
 
@@ -79,16 +64,17 @@ v1::RegisterResponse register_remote(const std::shared_ptr<grpc::Channel>& chann
   v1::UploadHeader header;
   *header.mutable_params() = job.params;
   header.set_preview_points(job.preview_points);
-  std::vector<std::pair<v1::CloudRole, LocalFile>> uploads;
+  std::vector<LocalFile> uploads;
+  std::vector<v1::CloudRole> roles;
   if (job.by_reference) {
     header.mutable_source()->set_path(job.source);
     header.mutable_target()->set_path(job.target);
   } else {
     // Both files are checked before connecting: a typo costs no upload.
-    uploads.emplace_back(v1::CLOUD_ROLE_SOURCE, describe_local_file(job.source));
-    uploads.emplace_back(v1::CLOUD_ROLE_TARGET, describe_local_file(job.target));
-    *header.mutable_source()->mutable_upload() = uploads[0].second.description;
-    *header.mutable_target()->mutable_upload() = uploads[1].second.description;
+    uploads = {describe_local_file(job.source), describe_local_file(job.target)};
+    roles = {v1::CLOUD_ROLE_SOURCE, v1::CLOUD_ROLE_TARGET};
+    *header.mutable_source()->mutable_upload() = uploads[0].description;
+    *header.mutable_target()->mutable_upload() = uploads[1].description;
   }
 
   const auto deadline =
@@ -100,7 +86,7 @@ v1::RegisterResponse register_remote(const std::shared_ptr<grpc::Channel>& chann
     add_call_metadata(context, connection, policy.request_id);
     if (policy.deadline_s > 0) context.set_deadline(deadline);
     v1::RegisterResponse response;
-    const grpc::Status status = Attempt(*stub, context, observer).run(header, uploads, response);
+    const grpc::Status status = Attempt(*stub, context, observer).run(header, uploads, roles, response);
     if (status.ok()) {
       if (!response.has_result()) throw CommandError("INTERNAL: the server ended the call without a result");
       return response;
