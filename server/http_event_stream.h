@@ -45,13 +45,7 @@ class StreamedCall {
       if (now - last_progress_ < std::chrono::milliseconds(100)) return;
       last_progress_ = now;  // only the job's worker posts stages
     }
-    Event event;
-    v1::StageEvent& stage_event = *event.mutable_stage();
-    stage_event.set_stage(stage);
-    stage_event.set_phase(phase);
-    stage_event.set_fraction(fraction);
-    stage_event.set_elapsed_s(std::chrono::duration<double>(now - clock.job_start).count());
-    post(event);
+    post(make_stage_event<Event>(stage, phase, fraction, clock, now));
   }
   // Waits for the next line; false once finished and every line was taken.
   bool next(std::string& line);

@@ -98,22 +98,22 @@ class JobStreamReactor : public Base {
     writing_ = true;
     this->StartWrite(&outbox_.front());  // a deque keeps the front in place while later messages are added
   }
-  // A stage event (both messages carry one as `stage`); progress events at most every 100 ms.
-  void post_stage(const std::string& stage, v1::StageEvent::Phase phase, double fraction,
-                  std::chrono::steady_clock::time_point job_start) {
-    const auto now = std::chrono::steady_clock::now();
-    Message message;
-    v1::StageEvent& event = *message.mutable_stage();
-    event.set_stage(stage);
-    event.set_phase(phase);
-    event.set_fraction(fraction);
-    event.set_elapsed_s(std::chrono::duration<double>(now - job_start).count());
-    std::lock_guard lock(mutex_);
-    if (phase == v1::StageEvent::PHASE_PROGRESS) {
-      if (now - last_progress_ < std::chrono::milliseconds(100)) return;
-      last_progress_ = now;
-    }
-    post_locked(std::move(message));
+  // The job's stage events (both messages carry one as `stage`), timed from the job's start; progress events
+  // at most every 100 ms. Any thread.
+  std::function<void(const std::string&, v1::StageEvent::Phase, double)> stage_listener(const CallClock& clock) {
+    return [this, &clock](const std::string& stage, v1::StageEvent::Phase phase, double fraction) {
+      const auto now = CallClock::Clock::now();
+      std::lock_guard lock(mutex_);
+      if (phase == v1::StageEvent::PHASE_PROGRESS) {
+        if (now - last_progress_ < std::chrono::milliseconds(100)) return;
+        last_progress_ = now;
+      }
+      post_locked(make_stage_event<Message>(stage, phase, fraction, clock, now));
+    };
+  }
+  // post() as a function for the job's other events.
+  std::function<void(Message)> poster() {
+    return [this](Message message) { post(std::move(message)); };
   }
   // Any thread; only the first call counts. The call ends with `status` once the outbox is empty.
   void finish(const grpc::Status& status) {

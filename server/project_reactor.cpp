@@ -38,11 +38,7 @@ grpc::Status run_project_call(const ServiceContext& service, Job& job, const Pro
 }
 
 void ProjectReactor::execute(Job& job) {
-  const StageListener stages = [this](const std::string& stage, v1::StageEvent::Phase phase, double fraction) {
-    post_stage(stage, phase, fraction, clock_.job_start);
-  };
-  finish(run_project_call(service_, job, project_, clock_, record_, stages,
-                          [this](v1::RegisterProjectEvent event) { post(std::move(event)); }));
+  finish(run_project_call(service_, job, project_, clock_, record_, stage_listener(clock_), poster()));
 }
 
 void ProjectReactor::on_finishing(const grpc::Status& status) {

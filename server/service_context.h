@@ -72,6 +72,20 @@ struct CallClock {
   Clock::time_point call_start = Clock::now(), upload_start, upload_end, enqueued, job_start, job_end;
 };
 
+// A stage event as both streams send it (Event: RegisterStreamResponse or RegisterProjectEvent, each carries one
+// as `stage`), timed from the job's start.
+template <typename Event>
+Event make_stage_event(const std::string& stage, v1::StageEvent::Phase phase, double fraction, const CallClock& clock,
+                       CallClock::Clock::time_point now) {
+  Event event;
+  v1::StageEvent& stage_event = *event.mutable_stage();
+  stage_event.set_stage(stage);
+  stage_event.set_phase(phase);
+  stage_event.set_fraction(fraction);
+  stage_event.set_elapsed_s(std::chrono::duration<double>(now - clock.job_start).count());
+  return event;
+}
+
 inline double seconds(CallClock::Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
 // The ServerTimings of a job that ran on `clock`; call just before the reply leaves.

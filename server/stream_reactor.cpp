@@ -26,12 +26,9 @@ void StreamReactor::on_chunk(const v1::RegisterStreamRequest& request) {
 }
 
 void StreamReactor::execute(Job& job) {
-  const StageListener listener = [this](const std::string& stage, v1::StageEvent::Phase phase, double fraction) {
-    post_stage(stage, phase, fraction, clock_.job_start);
-  };
   v1::RegisterStreamResponse reply;
   const grpc::Status status =
-      run_job(service_, job, source_, target_, params_, preview_points_, listener, clock_, record_,
+      run_job(service_, job, source_, target_, params_, preview_points_, stage_listener(clock_), clock_, record_,
               *reply.mutable_result());
   if (status.ok()) post(std::move(reply));
   finish(status);
