@@ -161,6 +161,7 @@ Eigen::Matrix4d to_file_frames(const Eigen::Matrix4d& local, const Eigen::Vector
 // 0.95-1.00 on every simulated scene, at 0.4 to 1.5 M points. One that explains less than 0.9 of it is not
 // taken as the truth, however well it beats its rivals (the monument's wrong poses where 4PCS had missed
 // the truth: 0.6-0.9).
+// Without free space, an intensity pose below this meets the geometric signal's best.
 constexpr double kSignalFallback = 0.6;
 constexpr double kWellSupportedWithFreeSpace = 0.9;
 // With free space an intensity pose below what true poses reach leaves room for a better one: the geometric
