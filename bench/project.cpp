@@ -159,6 +159,11 @@ std::vector<Suite> all_suites(const fs::path& data, const std::string& cache) {
       simulated("monument", 8, {0, 1, 3}, 700000, 0.1, 0.1, 0.4, "held-out", cache, "-fbs"),
       simulated("monument", 9, {0, 1, 3}, 700000, 0.1, 0.1, 0.4, "held-out", cache, "-fbs"),
       simulated("monument", 10, {0, 1, 3}, 700000, 0.1, 0.1, 0.4, "held-out", cache, "-fbs"),
+      // Added unseen after the links judged from both sides (2026-12-05), which hall layouts 1 and 4 (held out
+      // until then, refused three of four stations) were looked at for: their first run is reported.
+      simulated("hall", 5, {0, 1, 2, 4}, 700000, 0.05, 0.1, 0.4, "held-out", cache),
+      simulated("hall", 6, {0, 1, 2, 4}, 700000, 0.05, 0.1, 0.4, "held-out", cache),
+      simulated("hall", 7, {0, 1, 2, 4}, 700000, 0.05, 0.1, 0.4, "held-out", cache),
       simulated("courtyard", 0, stations_up_to(6), 1000000, 0.1, 0.1, 0.4, "scaling", cache),
       simulated("courtyard", 0, stations_up_to(12), 1000000, 0.1, 0.1, 0.4, "scaling", cache),
       simulated("courtyard", 0, stations_up_to(24), 1000000, 0.1, 0.1, 0.4, "scaling", cache),
@@ -241,19 +246,20 @@ double stage_seconds(const Run& r, std::initializer_list<const char*> stages) {
 }
 
 // Where a project's time goes as it grows: reading, the per-scan stages (each scan prepared once), the pairs,
-// selection, judging the poses open loops imply, and refinement; all pairs, so the pairs grow as N(N-1)/2.
+// judging weak links from both sides, selection, judging the poses open loops imply, and refinement; all pairs, so the pairs grow as N(N-1)/2.
 std::string scaling_report(const std::vector<Run>& runs) {
   std::ostringstream out;
   out << "| project | scans | pairs | correct | not registered | **confident miss** | wall | read | per-scan stages | pairs | "
-         "selection | loop poses | refinement |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+         "both sides | selection | loop poses | refinement |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const Run& r : runs) {
     if (r.part != "scaling") continue;
     const double per_scan = stage_seconds(r, {"voxel_grid", "keypoints", "icp_setup"});
     const double pairs = stage_seconds(r, {"matching", "symmetry_guard", "icp", "verdict", "polish", "plain_grid"});
     out << fmt::format(
-        "| {} | {} | {} | {} | {} | **{}** | {:.1f} s | {:.1f} s | {:.1f} s | {:.1f} s | {:.2f} s | {:.1f} s | {:.2f} s |\n", r.suite,
-        r.scans, r.links, r.correct, r.refused ? r.scans : r.unregistered, r.confident_misses, r.read_seconds + r.seconds,
-        r.read_seconds, per_scan, pairs, stage_seconds(r, {"selection"}), stage_seconds(r, {"loop_poses"}),
+        "| {} | {} | {} | {} | {} | **{}** | {:.1f} s | {:.1f} s | {:.1f} s | {:.1f} s | {:.1f} s | {:.2f} s | {:.1f} s | {:.2f} s |\n",
+        r.suite, r.scans, r.links, r.correct, r.refused ? r.scans : r.unregistered, r.confident_misses,
+        r.read_seconds + r.seconds, r.read_seconds, per_scan, pairs, stage_seconds(r, {"both_sides"}),
+        stage_seconds(r, {"selection"}), stage_seconds(r, {"loop_poses"}),
         stage_seconds(r, {"refinement"}));
   }
   return out.str();

@@ -14,6 +14,7 @@ ProjectResult project_result_from_proto(const v1::ProjectResult& m) {
     scan.links.assign(s.links().begin(), s.links().end());
     scan.points = s.points();
     scan.strength = s.strength();
+    scan.constraint = api::constraint_from_proto(s.constraint());
     scan.reason = s.reason();
     r.scans.push_back(std::move(scan));
   }
@@ -42,6 +43,11 @@ ProjectResult project_result_from_proto(const v1::ProjectResult& m) {
     link.seconds = l.seconds();
     link.judged_loop_poses = l.judged_loop_poses();
     link.loop_pose_won = l.loop_pose_won();
+    link.reverse_judged = l.reverse_judged();
+    link.reverse_margin = l.reverse_margin();
+    link.two_sided_margin = l.two_sided_margin();
+    link.runner_up_preferred = l.runner_up_preferred();
+    link.constraint = api::constraint_from_proto(l.constraint());
     r.links.push_back(std::move(link));
   }
   r.reference = m.reference();

@@ -8,6 +8,7 @@
 
 #include "k4reg/io/e57_io.h"
 #include "k4reg/io/matrix_file.h"
+#include "k4reg/registration/translation_constraint.h"
 #include "k4reg/util/error.h"
 #include "result_report.h"
 
@@ -27,6 +28,8 @@ nlohmann::json project_to_json(const ProjectResult& r, const std::vector<ScanOri
                           {"links", s.links},
                           {"points", s.points},
                           {"strength", s.strength},
+                          {"axis_constraint", axis_constraint(s.constraint)},
+                          {"weakest_constraint", weakest_constraint(s.constraint)},
                           {"reason", s.reason}});
   }
   j["links"] = nlohmann::json::array();
@@ -53,7 +56,13 @@ nlohmann::json project_to_json(const ProjectResult& r, const std::vector<ScanOri
                           {"overlap_used", l.overlap_used},
                           {"seconds", l.seconds},
                           {"judged_loop_poses", l.judged_loop_poses},
-                          {"loop_pose_won", l.loop_pose_won}});
+                          {"loop_pose_won", l.loop_pose_won},
+                          {"reverse_judged", l.reverse_judged},
+                          {"reverse_margin", l.reverse_margin},
+                          {"two_sided_margin", l.two_sided_margin},
+                          {"runner_up_preferred", l.runner_up_preferred},
+                          {"axis_constraint", axis_constraint(l.constraint)},
+                          {"weakest_constraint", weakest_constraint(l.constraint)}});
   j["reference"] = r.reference;
   j["scans_registered"] = r.scans_registered;
   j["loops_checked"] = r.loops_checked;
@@ -76,7 +85,9 @@ void print_project_table(std::ostream& out, const ProjectResult& r, const std::v
   for (std::size_t i = 0; i < r.scans.size(); ++i) {
     const ProjectScan& s = r.scans[i];
     out << fmt::format("scan {} {}: {}\n", i, origins.at(i).label(),
-                       s.registered ? fmt::format("registered (strength {:.3f})", s.strength) : "NOT registered: " + s.reason);
+                       s.registered ? fmt::format("registered (strength {:.3f}, weakest constraint {:.2f})", s.strength,
+                                                  weakest_constraint(s.constraint))
+                                    : "NOT registered: " + s.reason);
     if (s.registered) out << format_matrix4(s.pose);
   }
   out << fmt::format("{:<6}{:<10}{:>9}{:>9}{:>8}{:>8}{:>12}{:>12}  {}\n", "link", "scans", "rmse m", "overlap", "margin",

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "k4reg/io/matrix_file.h"
+#include "k4reg/registration/translation_constraint.h"
 
 namespace k4reg::cli {
 
@@ -37,6 +38,8 @@ nlohmann::json result_to_json(const RegistrationResult& r) {
   j["ambiguity_reason"] = r.ambiguity_reason;
   j["min_scale_m_used"] = r.min_scale_m_used;
   j["overlap_used"] = r.overlap_used;
+  j["axis_constraint"] = axis_constraint(r.constraint);
+  j["weakest_constraint"] = weakest_constraint(r.constraint);
   j["bases_tried"] = r.bases_tried;
   j["seed"] = r.seed;
   j["icp_converged"] = r.icp_converged;
@@ -75,6 +78,9 @@ void print_result_table(std::ostream& out, const RegistrationResult& r) {
   out << fmt::format("{:<22}{:.4f} m\n", "rmse", r.rmse_m);
   out << fmt::format("{:<22}{:.1f} %\n", "overlap", 100.0 * r.overlap);
   out << fmt::format("{:<22}{}\n", "inliers", r.inliers);
+  const std::array<double, 3> axis = axis_constraint(r.constraint);
+  out << fmt::format("{:<22}x {:.2f}  y {:.2f}  z {:.2f}  (weakest direction {:.2f}; 1 = as firm as the average)\n",
+                     "constraint", axis[0], axis[1], axis[2], weakest_constraint(r.constraint));
   out << fmt::format("{:<22}{} / {}\n", "points", r.source_points, r.target_points);
   out << fmt::format("{:<22}{} / {} ({})\n", "keypoints", r.source_keypoints, r.target_keypoints, r.signal);
   out << fmt::format("{:<22}{:.4g} m\n", "min scale used", r.min_scale_m_used);

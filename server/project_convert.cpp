@@ -45,6 +45,7 @@ void project_result_to_proto(const ProjectResult& r, const std::vector<std::stri
     for (std::size_t l : s.links) out.add_links(static_cast<std::uint32_t>(l));
     out.set_points(s.points);
     out.set_strength(s.strength);
+    constraint_to_proto(s.constraint, &out);
     out.set_reason(s.reason);
   }
   for (const ProjectLink& l : r.links) {
@@ -72,6 +73,11 @@ void project_result_to_proto(const ProjectResult& r, const std::vector<std::stri
     out.set_seconds(l.seconds);
     out.set_judged_loop_poses(static_cast<std::uint32_t>(l.judged_loop_poses));
     out.set_loop_pose_won(l.loop_pose_won);
+    out.set_reverse_judged(l.reverse_judged);
+    out.set_reverse_margin(l.reverse_margin);
+    out.set_two_sided_margin(l.two_sided_margin);
+    out.set_runner_up_preferred(l.runner_up_preferred);
+    constraint_to_proto(l.constraint, &out);
   }
   m->set_reference(static_cast<std::uint32_t>(r.reference));
   m->set_scans_registered(static_cast<std::uint32_t>(r.scans_registered));

@@ -162,6 +162,7 @@ void result_to_proto(const RegistrationResult& r, v1::RegistrationResult* m) {
   m->set_seed(r.seed);
   m->set_icp_converged(r.icp_converged);
   m->set_icp_iterations(r.icp_iterations);
+  constraint_to_proto(r.constraint, m);
   m->clear_timings();
   for (const StageTiming& t : r.timings) {
     v1::StageTiming* out = m->add_timings();

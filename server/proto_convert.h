@@ -3,6 +3,7 @@
 
 #include "k4reg/qa/cloud_preview.h"
 #include "k4reg/registration/registration.h"
+#include "k4reg/registration/translation_constraint.h"
 #include "k4reg/v1/registration.pb.h"
 
 namespace k4reg::service {
@@ -32,5 +33,16 @@ std::string cloud_digest(const v1::PairCloud& message);
 
 // Row-major 4x4 -> 16 repeated doubles.
 void matrix_to_proto(const Eigen::Matrix4d& matrix, google::protobuf::RepeatedField<double>* values);
+// A translation constraint (translation_constraint.h) into a message's constraint (9 numbers, row-major),
+// axis_constraint and weakest_constraint.
+template <typename Message>
+void constraint_to_proto(const Eigen::Matrix3d& constraint, Message* m) {
+  m->clear_constraint();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) m->add_constraint(constraint(r, c));
+  m->clear_axis_constraint();
+  for (const double axis : axis_constraint(constraint)) m->add_axis_constraint(axis);
+  m->set_weakest_constraint(weakest_constraint(constraint));
+}
 
 }  // namespace k4reg::service

@@ -30,13 +30,27 @@ std::vector<Eigen::Vector3f> vectors_from_bytes(const std::string& bytes, const 
   return values_from_bytes<Eigen::Vector3f>(bytes, what);
 }
 
-Eigen::Matrix4d matrix_from_proto(const google::protobuf::RepeatedField<double>& values) {
-  if (values.size() != 16)
-    fail(ErrorCode::kInvalidArgument, fmt::format("a transform of {} numbers, not 16", values.size()));
-  Eigen::Matrix4d m;
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) m(r, c) = values.Get(4 * r + c);
+namespace {
+
+// An N x N matrix from its N * N numbers, row-major; `what` names it in the error.
+template <int N>
+Eigen::Matrix<double, N, N> square_from_proto(const google::protobuf::RepeatedField<double>& values, const char* what) {
+  if (values.size() != N * N)
+    fail(ErrorCode::kInvalidArgument, fmt::format("{} of {} numbers, not {}", what, values.size(), N * N));
+  Eigen::Matrix<double, N, N> m;
+  for (int r = 0; r < N; ++r)
+    for (int c = 0; c < N; ++c) m(r, c) = values.Get(N * r + c);
   return m;
+}
+
+}  // namespace
+
+Eigen::Matrix4d matrix_from_proto(const google::protobuf::RepeatedField<double>& values) {
+  return square_from_proto<4>(values, "a transform");
+}
+
+Eigen::Matrix3d constraint_from_proto(const google::protobuf::RepeatedField<double>& values) {
+  return values.empty() ? Eigen::Matrix3d::Zero() : square_from_proto<3>(values, "a translation constraint");
 }
 
 std::vector<Eigen::Vector3d> points_from_proto(const google::protobuf::RepeatedField<double>& values) {
@@ -74,6 +88,7 @@ RegistrationResult result_from_proto(const v1::RegistrationResult& m) {
   r.seed = m.seed();
   r.icp_converged = m.icp_converged();
   r.icp_iterations = m.icp_iterations();
+  r.constraint = constraint_from_proto(m.constraint());
   for (const v1::StageTiming& t : m.timings()) r.timings.push_back({t.stage(), t.seconds()});
   return r;
 }

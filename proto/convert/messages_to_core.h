@@ -12,6 +12,8 @@ namespace k4reg::api {
 
 // 16 numbers, row-major.
 Eigen::Matrix4d matrix_from_proto(const google::protobuf::RepeatedField<double>& values);
+// A translation constraint's 9 numbers (row-major); none (a peer of an older version) gives zero.
+Eigen::Matrix3d constraint_from_proto(const google::protobuf::RepeatedField<double>& values);
 // x, y, z of each point in turn.
 std::vector<Eigen::Vector3d> points_from_proto(const google::protobuf::RepeatedField<double>& values);
 RegistrationResult result_from_proto(const v1::RegistrationResult& message);

@@ -200,7 +200,7 @@ TEST(LoopClosure, LoopsClosedOnlyThroughARunnerUpImplyWhatTheWinnersGive) {
 TEST(LoopClosure, ImpliedPosesWinTieOrLoseOnThePairsClouds) {
   const Project p;
   const Eigen::Matrix4d truth = p.relative(0, 1), winner = kFlip * truth;
-  const LinkCandidates link{0, 1, {winner}, 0.05, false, 0.3, true};
+  const LinkCandidates link{0, 1, {winner}, 0.05, false, 0.3, true, {}};
   auto judged = [&](const Eigen::Matrix4d& first, const Eigen::Matrix4d& second, double second_refined, double margin) {
     RegistrationResult r;
     r.transform = first;

@@ -10,6 +10,7 @@
 #include "k4reg/io/gt_pairs.h"
 #include "k4reg/project/pair_runner.h"
 #include "k4reg/project/project_registration.h"
+#include "k4reg/registration/translation_constraint.h"
 #include "k4reg/util/error.h"
 
 namespace k4reg {
@@ -88,6 +89,9 @@ TEST(ProjectRegistration, BunnyScansAllRegisteredWithinAMillimetre) {
   for (std::size_t i = 0; i < 6; ++i) {
     EXPECT_TRUE(r.scans[i].registered) << bunny.files[i] << ": " << r.scans[i].reason;
     EXPECT_LT(rms_error_m(bunny.scans[i], r.scans[i].pose, bunny.truth[i]), 0.001) << bunny.files[i];
+    // A curved object pins every direction: its constraint (trace 3) has no free direction.
+    EXPECT_NEAR(r.scans[i].constraint.trace(), 3.0, 1e-9) << bunny.files[i];
+    EXPECT_GT(weakest_constraint(r.scans[i].constraint), 0.2) << bunny.files[i];
   }
   EXPECT_EQ(r.links.size(), 15u);
   EXPECT_EQ(r.loops_checked, 20u);
@@ -96,6 +100,13 @@ TEST(ProjectRegistration, BunnyScansAllRegisteredWithinAMillimetre) {
   for (const ProjectLink& l : r.links) {
     if (l.accepted) {
       EXPECT_GE(l.residual_m, 0.0);
+      EXPECT_NEAR(l.constraint.trace(), 3.0, 1e-9);
+    }
+    // Only a well-supported winner with a small margin is judged from both sides, and its margin then adds up.
+    if (l.reverse_judged) {
+      EXPECT_TRUE(l.well_supported);
+      EXPECT_LT(l.ambiguity_margin, kAmbiguousMargin);
+      EXPECT_GE(l.two_sided_margin, 0.0);
     }
   }
   // Pairwise stages, then the project's own.
@@ -113,6 +124,7 @@ TEST(ProjectRegistration, ScanOfAnotherObjectIsNotRegisteredAndTheRestStill) {
   std::vector<PointCloud> scans{bunny.scans[0], bunny.scans[1], bunny.scans[4], make_local_cloud(mirrored, {})};
   const ProjectResult r = register_project(scans, statue_params());
   EXPECT_FALSE(r.scans[3].registered);
+  EXPECT_TRUE(r.scans[3].constraint.isZero()) << "an unregistered scan is pinned by nothing";
   for (std::size_t i : {0, 1, 2}) {
     EXPECT_TRUE(r.scans[i].registered) << i;
     const std::size_t original = i == 2 ? 4 : i;

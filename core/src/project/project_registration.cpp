@@ -14,6 +14,8 @@
 #include "k4reg/project/pose_graph.h"
 #include "k4reg/project/scan_conflicts.h"
 #include "k4reg/project/scan_strength.h"
+#include "k4reg/project/two_sided_margin.h"
+#include "k4reg/registration/translation_constraint.h"
 #include "k4reg/util/error.h"
 
 namespace k4reg {
@@ -88,11 +90,13 @@ void place_scans(ProjectResult& r, const std::vector<double>& radius) {
                                        : "its accepted links do not agree on where it goes, or reach the reference";
 }
 
-// A link's weight in the scans' strength: its pairwise margin where its winner was chosen and is well
-// supported, at least one pair's worth where a vouching loop confirmed it, else nothing.
+// A link's weight in the scans' strength: its margin (two-sided where judged from both sides) where its first
+// candidate was chosen and is well supported, at least one pair's worth where a vouching loop confirmed it, else
+// nothing.
 double strength_weight(const ProjectLink& link) {
-  const double margin = link.candidate == 0 && link.well_supported ? link.ambiguity_margin : 0.0;
-  return link.verdict == "confirmed" ? std::max(margin, kAmbiguousMargin) : margin;
+  const double margin = link.reverse_judged ? link.two_sided_margin : link.ambiguity_margin;
+  const double weight = link.candidate == 0 && link.well_supported ? margin : 0.0;
+  return link.verdict == "confirmed" ? std::max(weight, kAmbiguousMargin) : weight;
 }
 
 // Rejects an accepted link: it leaves its scans' lists.
@@ -116,7 +120,7 @@ LinkCandidates link_from_outcome(const PairOutcome& outcome, const ScanPair& pai
   link.source = s;
   link.target = t;
   link.seconds = outcome.seconds;
-  LinkCandidates c{s, t, {}, 0.0, false, 0.0, false};
+  LinkCandidates c{s, t, {}, 0.0, false, 0.0, false, {}};
   if (!outcome.result) {
     link.verdict = "failed";
     link.reason = outcome.error ? outcome.error->what() : "not registered";
@@ -132,10 +136,18 @@ LinkCandidates link_from_outcome(const PairOutcome& outcome, const ScanPair& pai
   link.well_supported = result.well_supported;
   link.min_scale_m_used = result.min_scale_m_used;
   link.overlap_used = result.overlap_used;
+  link.constraint = result.constraint;
+  link.reverse_judged = link.runner_up_preferred = false;
+  link.reverse_margin = link.two_sided_margin = 0.0;
   c.transforms.push_back(result.transform);
+  c.scores.push_back(link.cloud_score);
   // Runner-ups the free space contradicts outright (a score of 0 or less) cannot be the truth.
-  for (std::size_t h = 1; h < result.hypotheses.size(); ++h)
-    if (result.hypotheses[h].cloud_score > 0) c.transforms.push_back(result.hypotheses[h].transform);
+  for (std::size_t h = 1; h < result.hypotheses.size(); ++h) {
+    const Hypothesis& hypothesis = result.hypotheses[h];
+    if (hypothesis.cloud_score <= 0) continue;
+    c.transforms.push_back(hypothesis.transform);
+    c.scores.push_back(hypothesis.refined_score > 0 ? hypothesis.refined_score : hypothesis.cloud_score);
+  }
   link.hypotheses = c.transforms.size();
   link.transform = result.transform;
   c.tolerance_m = link_tolerance_m(link);
@@ -196,13 +208,37 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
       for (const StageTiming& t : outcomes[k].result->timings) add_timing(r.timings, t.stage, t.seconds);
   }
 
-  // 2. One candidate per link, so that the loops close. Where a loop stays open, the pose its other two links
-  //    imply for a link is judged on the link's own clouds (the pair's 4PCS may have missed the truth), and the
-  //    loops choose again.
-  auto start = Clock::now();
   if (progress) progress("selection", 0.0);
   std::vector<double> radius(scans.size());
   for (std::size_t i = 0; i < scans.size(); ++i) radius[i] = scan_radius_m(scans[i]);
+
+  // 2a. Weak links judged from both sides: a well-supported winner with a small margin, and its runner-up, are
+  //     judged again with the scans swapped, and the two sides' margins add up (two_sided_margin.h).
+  auto start = Clock::now();
+  for (std::size_t l = 0; l < r.links.size(); ++l) {
+    const LinkCandidates& c = candidates[l];
+    if (c.transforms.size() < 2 || !c.well_supported || c.margin >= kAmbiguousMargin) continue;
+    check(&budget);
+    if (progress) progress("selection", 0.5 * static_cast<double>(l) / r.links.size());  // judging is part of it
+    ProjectLink& link = r.links[l];
+    RegistrationParams judge = pairwise;
+    judge.overlap = link.overlap_used;  // at the project's scale, as the loops' poses are judged below
+    const auto [s, t] = pairs[l];
+    const TwoSidedJudgement j = judge_from_both_sides(prepared[s], prepared[t], candidates[l], judge, radius, &budget);
+    if (!j.judged) continue;
+    link.reverse_judged = true;
+    link.runner_up_preferred = j.runner_up_preferred;
+    link.reverse_margin = j.reverse_margin;
+    link.two_sided_margin = j.margin;
+    link.transform = candidates[l].transforms.front();
+    link.cloud_score = candidates[l].scores.front();
+  }
+  add_timing(r.timings, "both_sides", seconds_since(start));
+
+  // 2. One candidate per link, so that the loops close. Where a loop stays open, the pose its other two links
+  //    imply for a link is judged on the link's own clouds (the pair's 4PCS may have missed the truth), and the
+  //    loops choose again.
+  start = Clock::now();
   const LoopSelectionResult first = select_loop_consistent(candidates, radius);
   const std::vector<std::vector<Eigen::Matrix4d>> implied = poses_implied_by_open_loops(candidates, first, radius);
   add_timing(r.timings, "selection", seconds_since(start));
@@ -210,7 +246,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
   for (std::size_t l = 0; l < r.links.size(); ++l) {
     if (implied[l].empty()) continue;
     check(&budget);
-    if (progress) progress("selection", static_cast<double>(l) / r.links.size());  // judging is part of it
+    if (progress) progress("selection", 0.5 + 0.5 * static_cast<double>(l) / r.links.size());  // judging is part of it
     const auto [s, t] = pairs[l];
     RegistrationParams judge = pairwise;
     // At the project's scale (or the automatic start), not at a finer one the pair may have stepped down to.
@@ -360,6 +396,15 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     r.global_rmse_m = used.empty() ? 0.0 : std::sqrt(sum_sq / used.size());
     for (std::size_t i = 0; i < r.scans.size(); ++i)
       if (r.scans[i].registered) r.scans[i].pose = refined.poses[i];
+    // Each scan's links pin it along the directions their surfaces face, in the project's frame.
+    for (std::size_t l : used) {
+      const ProjectLink& link = r.links[l];
+      const Eigen::Matrix3d in_project =
+          rotated_constraint(link.constraint, r.scans[link.target].pose.topLeftCorner<3, 3>());
+      r.scans[link.source].constraint += in_project;
+      r.scans[link.target].constraint += in_project;
+    }
+    for (ProjectScan& scan : r.scans) scan.constraint = normalized_constraint(scan.constraint);
     break;
   }
   r.scans_registered = std::count_if(r.scans.begin(), r.scans.end(), [](const ProjectScan& s) { return s.registered; });

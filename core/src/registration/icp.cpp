@@ -181,6 +181,7 @@ IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const E
       const Accumulation acc =
           accumulate(src.points, tgt.points, tgt.normals, *tgt.grid, to_affine3f(result.transform), max_distance, voxel);
       result.inliers = acc.inliers;
+      result.translation_information = acc.hessian.bottomRightCorner<3, 3>();
       result.rmse_m = acc.inliers ? std::sqrt(acc.squared_residuals / acc.inliers) : 0.0;
       result.overlap = src.points.empty() ? 0.0 : double(acc.inliers) / src.points.size();
     }

@@ -25,6 +25,7 @@
 #include "k4reg/geometry/sampling.h"
 #include "k4reg/registration/surface_signal.h"
 #include "k4reg/registration/symmetry_guard.h"
+#include "k4reg/registration/translation_constraint.h"
 #include "k4reg/geometry/voxel_grid.h"
 
 namespace k4reg {
@@ -517,6 +518,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   result.rmse_m = final_icp.rmse_m;
   result.overlap = final_icp.overlap;
   result.inliers = final_icp.inliers;
+  result.constraint = normalized_constraint(final_icp.translation_information);
 
   // The smallest overlap searched sets what a true pose must explain.
   const double needed = well_supported(overlaps[std::min(rounds_run, overlaps.size()) - 1], result.free_space_used);

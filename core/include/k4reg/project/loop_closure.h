@@ -32,6 +32,7 @@ struct LinkCandidates {
   bool ambiguous = false;    // the pairwise verdict on its winner
   double margin = 1.0;       // the pairwise ambiguity margin of its winner
   bool well_supported = true;  // its winner lies on the surface and explains what a true pose would
+  std::vector<double> scores;  // per transform, its pairwise score (refined where it was refined); may be empty
 };
 
 enum class LinkVerdict {

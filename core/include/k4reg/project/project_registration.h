@@ -1,5 +1,6 @@
 // Project registration: N scans into one frame (after Theiler, Wegner, Schindler 2015), top to bottom:
 //   candidate pairs (candidate_pairs.h)  ->  pairwise K-4PCS per pair, keeping its distinct hypotheses
+//   ->  links whose well-supported winner has a small margin judged from both sides (two_sided_margin.h)
 //   ->  loop-consistent selection of one hypothesis per link (loop_closure.h)  ->  where a loop stays open,
 //   the poses its links imply judged on each link's own clouds (judge_poses), and the selection again
 //   ->  initial poses by consensus of the accepted links, from the reference out  ->  conflicts, minority
@@ -9,8 +10,8 @@
 // symmetric twin, is reported as not registered, never forced into place. Pairs run one after the other, each on all
 // threads (or wherever a PairRunner sends them), so the result is the same at any thread count and on any runner.
 // Cost: one pairwise registration per candidate pair (0.2-3 s each at 1 M points on 2 cores); judging implied
-// poses, a guard and a verdict per link in an open loop of well-supported links (0.1-1 s each); selection and
-// refinement take milliseconds.
+// poses, a guard and a verdict per link in an open loop of well-supported links (0.1-1 s each), and as much per
+// weak link judged from both sides (2-4 s at 0.7 M points); selection and refinement take milliseconds.
 #pragma once
 
 #include <Eigen/Core>
@@ -43,12 +44,22 @@ struct ProjectLink {
   double rmse_m = 0.0, overlap = 0.0, cloud_score = 0.0, ambiguity_margin = 0.0;
   bool ambiguous = false, well_supported = false;
   double min_scale_m_used = 0.0, overlap_used = 0.0;
+  // How firmly the surfaces of its pairwise refinement pin the translation, in the target scan's frame
+  // (translation_constraint.h; the winner's, where the loops chose another candidate: a symmetric twin meets
+  // the same surfaces).
+  Eigen::Matrix3d constraint = Eigen::Matrix3d::Zero();
   std::size_t hypotheses = 0;  // distinct candidates the pairwise registration kept
   // Poses its open loops implied that its own clouds judged alongside its hypotheses (loop_closure.h), and
   // whether one of them won: the figures above are then that judgement's, else the pairwise result's.
   std::size_t judged_loop_poses = 0;
   bool loop_pose_won = false;
-  int candidate = -1;          // the one chosen (0 = the pairwise winner), -1 = none
+  // Where its pairwise winner was well supported but its margin small: judged from the target's side as well
+  // (two_sided_margin.h), that side's margin of its first candidate over the second (signed), the two sides'
+  // margins added (what the loops and the scans' strength use), and whether the two sides together preferred
+  // the pairwise runner-up, which then became its first candidate (and cloud_score is the runner-up's).
+  bool reverse_judged = false, runner_up_preferred = false;
+  double reverse_margin = 0.0, two_sided_margin = 0.0;
+  int candidate = -1;          // the one chosen (0 = the pairwise winner, or the runner-up both sides preferred), -1 = none
   bool accepted = false;
   std::string verdict;  // confirmed, unchecked, contradicted, unresolved, failed, inconsistent
   std::string reason;   // why not accepted (or how it was accepted), in words
@@ -67,6 +78,9 @@ struct ProjectScan {
   // capped at 1; under kAmbiguousMargin it is not registered.
   double strength = 0.0;
   std::string reason;  // why not registered, in words
+  // How firmly its links in the refined project pin its translation, in the project's frame: their constraints
+  // added and scaled to trace 3 (translation_constraint.h); zero when not registered or linked.
+  Eigen::Matrix3d constraint = Eigen::Matrix3d::Zero();
 };
 
 struct ProjectResult {

@@ -33,6 +33,9 @@ struct IcpResult {
   double rmse_m = 0.0;   // RMS point-to-plane residual of the final inliers
   double overlap = 0.0;  // share of source points with a target point within the final distance
   std::size_t inliers = 0;
+  // The final inliers' translation information Sum w n n^T (target frame): how the surfaces pin each direction
+  // (translation_constraint.h).
+  Eigen::Matrix3d translation_information = Eigen::Matrix3d::Zero();
   bool converged = false;
   int iterations = 0;
 };

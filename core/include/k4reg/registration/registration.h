@@ -103,6 +103,9 @@ struct RegistrationResult {
   double rmse_m = 0.0;          // RMS of the inlier residuals after refinement
   double overlap = 0.0;         // share of voxelised source points with a target neighbour after alignment
   std::size_t inliers = 0;
+  // How firmly the matched surfaces pin the translation per direction, in the target's frame (trace 3; the
+  // identity when surfaces face every way; see translation_constraint.h).
+  Eigen::Matrix3d constraint = Eigen::Matrix3d::Zero();
   std::size_t source_points = 0, target_points = 0;
   std::size_t source_voxels = 0, target_voxels = 0;
   std::size_t source_keypoints = 0, target_keypoints = 0;
