@@ -15,7 +15,7 @@ seconds=${K4REG_FUZZ_SECONDS:-45}
 
 # -O1 without NDEBUG: fast enough to fuzz, and assertions (ours, Eigen's) stay on.
 cmake -S . -B "$build" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" -DK4REG_BUILD_FUZZERS=ON -DK4REG_BUILD_TESTS=OFF -DK4REG_BUILD_BENCH=OFF
+  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" -DK4REG_BUILD_FUZZERS=ON -DK4REG_BUILD_TESTS=OFF -DK4REG_BUILD_BENCH=OFF
 cmake --build "$build" -j"$(nproc)" --target fuzzers
 
 targets=${K4REG_FUZZ_TARGETS:-$(ls "$build/fuzz")}
