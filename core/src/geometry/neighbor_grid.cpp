@@ -7,7 +7,7 @@
 
 namespace k4reg {
 
-NeighborGrid::NeighborGrid(const std::vector<Eigen::Vector3f>& points, double cell_m)
+NeighborGrid::NeighborGrid(const std::vector<Eigen::Vector3f>& points, double cell_m, Queries queries)
     : cell_m_(cell_m), inv_cell_(static_cast<float>(1.0 / cell_m)), cells_(points.size() / 4 + 16) {
   if (!(cell_m > 0.0)) fail(ErrorCode::kInvalidArgument, "neighbour grid cell must be positive, got " + std::to_string(cell_m));
   std::vector<std::uint32_t> cell_of(points.size());
@@ -32,6 +32,7 @@ NeighborGrid::NeighborGrid(const std::vector<Eigen::Vector3f>& points, double ce
   for (std::size_t i = 0; i < points.size(); ++i) order_[fill[cell_of[i]]++] = static_cast<std::uint32_t>(i);
   sorted_.resize(points.size());
   for (std::size_t k = 0; k < points.size(); ++k) sorted_[k] = points[order_[k]];
+  if (queries == Queries::kFew) return;
 
   // Cells next to occupied ones, then each one's occupied neighbours (counted, filled, sorted by key).
   // f(key, code) for the 27 cells around occupied cell c; code = (x + 1) + 3 (y + 1) + 9 (z + 1).

@@ -144,7 +144,7 @@ void find_congruent_sets(const Base& base, const std::vector<Eigen::Vector3f>& t
     crossings.push_back(qi + base.r1 * (qj - qi));
     crossings.push_back(qj + base.r1 * (qi - qj));
   }
-  const NeighborGrid grid(crossings, tolerance.coincidence_m);
+  const NeighborGrid grid(crossings, tolerance.coincidence_m, NeighborGrid::Queries::kFew);
 
   float edge[4];  // |p0 p2|, |p0 p3|, |p1 p2|, |p1 p3|
   for (int a = 0; a < 2; ++a)

@@ -3,6 +3,9 @@
 // of its occupied neighbours, so a query costs one hash look-up instead of up to 27 (ICP, the DoG and
 // the 4PCS verifier are dominated by these look-ups). For the near-uniform voxelised clouds of this pipeline this
 // is several times faster than a k-d tree. Cost: O(n) to build; O(neighbours) per query.
+// A grid queried about once per point (the congruent-set search builds one per 4PCS base) is built without those
+// lists (Queries::kFew): they cost 27 hash insertions per occupied cell, and a query then looks up the at most 8
+// cells its ball's box touches.
 #pragma once
 
 #include <algorithm>
@@ -17,7 +20,8 @@ namespace k4reg {
 
 class NeighborGrid {
  public:
-  NeighborGrid(const std::vector<Eigen::Vector3f>& points, double cell_m);
+  enum class Queries { kMany, kFew };
+  NeighborGrid(const std::vector<Eigen::Vector3f>& points, double cell_m, Queries queries = Queries::kMany);
 
   double cell_m() const { return cell_m_; }
 
@@ -33,7 +37,7 @@ class NeighborGrid {
         if (d2 <= r2) f(order_[k], d2);
       }
     };
-    if (radius_m <= cell_m_) {
+    if (radius_m <= cell_m_ && !near_offsets_.empty()) {
       // Any point within one cell lies in one of the 27 cells around q's: those listed for q's cell.
       const Around around = cells_around(q);
       for (std::uint32_t n = around.first; n < around.last; ++n)
@@ -63,7 +67,7 @@ class NeighborGrid {
       }
     };
     const float r2 = radius_m * radius_m;
-    if (radius_m > cell_m_) {
+    if (radius_m > cell_m_ || near_offsets_.empty()) {
       for_each_within(q, radius_m, [&](std::uint32_t i, float dd) {
         if (dd < best_d2) best_d2 = dd, best = static_cast<int>(i);
       });
@@ -118,7 +122,8 @@ class NeighborGrid {
   std::vector<std::uint32_t> order_;
   std::vector<Eigen::Vector3f> sorted_;  // points[order_[k]]: a cell's points are contiguous in memory
   // Every cell within one cell of an occupied one -> the occupied cells among its 27, in z, y, x order
-  // (the order of the general loop below, so both paths make the same calls in the same order).
+  // (the order of the general loop below, so both paths make the same calls in the same order). Empty for
+  // Queries::kFew.
   VoxelKeyMap near_map_;
   std::vector<std::uint32_t> near_offsets_;  // CSR into near_cells_
   std::vector<std::uint32_t> near_cells_;
