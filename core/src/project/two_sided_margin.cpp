@@ -30,12 +30,14 @@ TwoSidedJudgement judge_from_both_sides(const PreparedScan& source, const Prepar
     if (e.code() == ErrorCode::kCancelled || e.code() == ErrorCode::kDeadlineExceeded) throw;
     return out;
   }
-  LinkCandidates swapped = link;
-  std::swap(swapped.source, swapped.target);
-  // The refined score from the target's side of the judged pose that stands for `pose`; 0 where none does.
+  // The refined score from the target's side of the judged pose that stands for `pose` (within the link's loop
+  // tolerance, displacement where the target scan is); 0 where none does.
+  const double target_radius_m = scan_radius_m.at(link.target);
   auto reverse_score = [&](const Eigen::Matrix4d& pose) {
     for (const Hypothesis& h : judged.hypotheses)
-      if (h.refined_score > 0 && within_loop_tolerance(swapped, h.transform, pose, scan_radius_m)) return h.refined_score;
+      if (h.refined_score > 0 &&
+          displacement_m(rigid_inverse(h.transform) * pose, target_radius_m) <= kLoopToleranceFactor * link.tolerance_m)
+        return h.refined_score;
     return 0.0;
   };
   const double forward = side_margin(link.scores[0], link.scores[1]);
