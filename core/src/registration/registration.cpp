@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "k4reg/registration/dog_keypoints.h"
+#include "k4reg/registration/fine_polish.h"
 #include "k4reg/registration/prepared_scan.h"
 #include "k4reg/util/error.h"
 #include "k4reg/registration/four_pcs.h"
@@ -507,11 +508,12 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   result.hypotheses = std::move(verdict.hypotheses);
   result.ambiguity_margin = verdict.margin;
   const bool on_the_surface = verdict.on_surface;
-  // The winner polished on every source point at the finest stage; with --no-icp, its quality figures only.
-  IcpParams polish = final_params;
-  polish.finest_stage_only = true;
+  // The winner polished on every source point at the finest stage, and below it where that is cheap
+  // (fine_polish.h); with --no-icp, its quality figures only.
   const Hypothesis& best = result.hypotheses.front();
-  const IcpResult final_icp = timer.run("polish", [&] { return refine_icp(icp.first, icp.second, best.transform, polish, cancel); });
+  const IcpResult final_icp = timer.run("polish", [&] {
+    return polish_winner(source_scan, target_scan, icp.first, icp.second, sigma, best.transform, final_params, cancel);
+  });
   const Eigen::Matrix4d local = params.icp ? final_icp.transform : best.transform;
   result.icp_converged = params.icp && final_icp.converged;
   result.icp_iterations = params.icp ? verdict.iterations + final_icp.iterations : 0;
