@@ -8,6 +8,7 @@
 #include "k4reg/io/gt_pairs.h"
 #include "k4reg/registration/fine_polish.h"
 #include "k4reg/registration/registration.h"
+#include "pose_error.h"
 
 namespace k4reg {
 namespace {
@@ -26,17 +27,6 @@ TEST(FinePolish, QuarterSigmaForSmallScansNoneForLargeOnes) {
   EXPECT_EQ(fine_polish_spacing_m(0.1, 170000, 1000000, 0.01), 0.0);
   EXPECT_EQ(fine_polish_spacing_m(0.1, 12501, 1000000, 0.01), 0.0);
   EXPECT_GT(fine_polish_spacing_m(0.1, 12500, 1000000, 0.01), 0.0);
-}
-
-// RMS over the source's points of the distance between where the result and the truth put them.
-double rms_error_m(const PointCloud& source, const Eigen::Matrix4d& transform, const Eigen::Matrix4d& truth) {
-  double sum = 0.0;
-  for (const Eigen::Vector3f& p : source.points) {
-    Eigen::Vector4d q = Eigen::Vector4d::Ones();
-    q.head<3>() = p.cast<double>() + source.origin_m;
-    sum += (transform * q - truth * q).squaredNorm();
-  }
-  return std::sqrt(sum / source.size());
 }
 
 // Polished at sigma only, these three pairs end 0.28-0.34 mm from Stanford's registration (mean 0.31 mm); polished

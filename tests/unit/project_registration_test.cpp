@@ -12,6 +12,7 @@
 #include "k4reg/project/project_registration.h"
 #include "k4reg/registration/translation_constraint.h"
 #include "k4reg/util/error.h"
+#include "pose_error.h"
 
 namespace k4reg {
 namespace {
@@ -33,17 +34,6 @@ PointCloud moved(const PointCloud& cloud, const Eigen::Matrix4d& m) {
   for (const Eigen::Vector3f& p : cloud.points)
     points.push_back(m.topLeftCorner<3, 3>() * (p.cast<double>() + cloud.origin_m) + m.topRightCorner<3, 1>());
   return make_local_cloud(points, cloud.intensity);
-}
-
-// RMS over the scan's points of the distance between where the pose and the truth put them.
-double rms_error_m(const PointCloud& scan, const Eigen::Matrix4d& pose, const Eigen::Matrix4d& truth) {
-  double sum = 0.0;
-  for (const Eigen::Vector3f& p : scan.points) {
-    Eigen::Vector4d q = Eigen::Vector4d::Ones();
-    q.head<3>() = p.cast<double>() + scan.origin_m;
-    sum += (pose * q - truth * q).squaredNorm();
-  }
-  return std::sqrt(sum / scan.size());
 }
 
 // Six bunny scans with a ground-truth transform into bun000's frame, each moved at random.
