@@ -5,7 +5,8 @@
 //                       [--cache-dir DIR] [--results-dir DIR] [--markdown FILE] [--list]
 //
 // The scaling part (not in "all": about 12 minutes) registers the courtyard's first 6, 12 and 24 stations at 1 M
-// points, all pairs, automatic overlap (and 12 with the overlap given as 0.4), and splits the time into reading, the per-scan stages, the pairs, selection and refinement.
+// points, all pairs, automatic overlap (and 12 with the overlap given as 0.4), and splits the time into reading,
+// the per-scan stages, the pairs, selection and refinement.
 // It writes its own CSV (project-scaling-runs.csv) and RESULTS.md block ("project-scaling").
 //
 // Every scan's pose is scored against the ground truth relative to the reference scan (RMS over the

@@ -23,9 +23,9 @@ IcpResult polish_winner(const PreparedScan& source, const PreparedScan& target, 
   // The sampling (a few tens of milliseconds on a large scan) is measured only where the grid's size allows
   // a finer stage at all.
   auto fine_m = [&](const PreparedScan& scan) {
-    const std::size_t at_sigma = scan.voxels(sigma_m, cancel).cloud.size();
-    if (fine_polish_spacing_m(sigma_m, at_sigma, scan.cloud().size(), 0.0) == 0.0) return 0.0;
-    return fine_polish_spacing_m(sigma_m, at_sigma, scan.cloud().size(), scan.sampling().spacing_m);
+    const std::size_t points_at_sigma = scan.voxels(sigma_m, cancel).cloud.size();
+    if (fine_polish_spacing_m(sigma_m, points_at_sigma, scan.cloud().size(), 0.0) == 0.0) return 0.0;
+    return fine_polish_spacing_m(sigma_m, points_at_sigma, scan.cloud().size(), scan.sampling().spacing_m);
   };
   if (params.max_iterations == 0) return polished;
   const double source_m = fine_m(source);
