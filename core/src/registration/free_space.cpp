@@ -24,12 +24,20 @@ FreeSpaceImage::FreeSpaceImage(const std::vector<Eigen::Vector3f>& points, const
       elevation_cells_(elevation_cells_for(points.size())),
       azimuth_cells_(2 * elevation_cells_),
       nearest_(static_cast<std::size_t>(azimuth_cells_) * elevation_cells_, std::numeric_limits<float>::infinity()) {
+  constexpr std::size_t kRangeSampleEvery = 16;  // the reach is a quantile: a sample of the ranges will do
+  std::vector<float> sampled_ranges;
+  std::vector<std::size_t> per_row(elevation_cells_, 0);
+  sampled_ranges.reserve(points.size() / kRangeSampleEvery + 1);
+  std::size_t returns = 0;
   for (const Eigen::Vector3f& p : points) {
     const Eigen::Vector3f d = p - scanner_;
     const float range = d.norm();
     if (range <= 0) continue;
-    float& nearest = nearest_[cell(d / range)];
+    const int c = cell(d / range);
+    float& nearest = nearest_[c];
     nearest = std::min(nearest, range);
+    if (returns++ % kRangeSampleEvery == 0) sampled_ranges.push_back(range);
+    ++per_row[c / azimuth_cells_];
   }
   // Each cell takes the nearest return of its 3 x 3 neighbourhood. A cell's few returns may all lie at
   // its far side: on a surface seen at grazing incidence the range changes by metres across one cell,
@@ -48,6 +56,41 @@ FreeSpaceImage::FreeSpaceImage(const std::vector<Eigen::Vector3f>& points, const
         }
       }
     }
+  mark_open(own, per_row, returns, sampled_ranges);
+}
+
+// A scanner that returns from 70 m in most directions and from nothing in a wide patch of directions saw
+// no surface there within its reach: the sky over a plaza. A pose that puts trees or a facade into that
+// sky is contradicted as surely as one that puts them into a room's empty air. Only where the scanner
+// looked: within the band of elevations it returned from (a profiler or a Velodyne sees a band only), and
+// only where the whole neighbourhood is empty (a dark patch or a window leaves a hole of a cell or two).
+void FreeSpaceImage::mark_open(const std::vector<float>& own, const std::vector<std::size_t>& per_row,
+                               std::size_t returns, std::vector<float>& sampled_ranges) {
+  constexpr double kBandTail = 0.001;     // share of returns ignored at each end of the elevation band
+  constexpr double kReachQuantile = 0.99;
+  constexpr int kOpenRadiusCells = 3;     // 7 x 7 cells: 3.5 degrees for 0.7 M points
+  open_.assign(own.size(), false);
+  if (returns < 1000 || sampled_ranges.empty()) return;  // too few returns to tell a hole from sparse sampling
+  const std::size_t tail = static_cast<std::size_t>(kBandTail * returns);
+  int first_row = 0, last_row = elevation_cells_ - 1;
+  for (std::size_t below = 0; first_row < elevation_cells_ && below + per_row[first_row] <= tail; ++first_row)
+    below += per_row[first_row];
+  for (std::size_t above = 0; last_row >= 0 && above + per_row[last_row] <= tail; --last_row) above += per_row[last_row];
+  const auto nth = sampled_ranges.begin() + static_cast<std::ptrdiff_t>(kReachQuantile * (sampled_ranges.size() - 1));
+  std::nth_element(sampled_ranges.begin(), nth, sampled_ranges.end());
+  reach_m_ = *nth;
+  for (int e = first_row + kOpenRadiusCells; e <= last_row - kOpenRadiusCells; ++e)
+    for (int a = 0; a < azimuth_cells_; ++a) {
+      // Only cells without a return around them are ever asked (classify).
+      if (std::isfinite(nearest_[static_cast<std::size_t>(e) * azimuth_cells_ + a])) continue;
+      bool empty = true;
+      for (int de = -kOpenRadiusCells; de <= kOpenRadiusCells && empty; ++de)
+        for (int da = -kOpenRadiusCells; da <= kOpenRadiusCells && empty; ++da) {
+          const int aa = (a + da + azimuth_cells_) % azimuth_cells_;
+          empty = !std::isfinite(own[static_cast<std::size_t>(e + de) * azimuth_cells_ + aa]);
+        }
+      open_[static_cast<std::size_t>(e) * azimuth_cells_ + a] = empty;
+    }
 }
 
 int FreeSpaceImage::cell(const Eigen::Vector3f& u) const {
@@ -62,8 +105,9 @@ FreeSpaceImage::Seen FreeSpaceImage::classify(const Eigen::Vector3f& q) const {
   const Eigen::Vector3f d = q - scanner_;
   const float range = d.norm();
   if (range <= margin_) return Seen::kUnknown;
-  const float nearest = nearest_[cell(d / range)];
-  if (!std::isfinite(nearest)) return Seen::kUnknown;
+  const int c = cell(d / range);
+  const float nearest = nearest_[c];
+  if (!std::isfinite(nearest)) return open_[c] && range < reach_m_ ? Seen::kOpen : Seen::kUnknown;
   if (range < nearest - margin_) return Seen::kEmpty;
   return range <= nearest + margin_ ? Seen::kSurface : Seen::kOccluded;
 }

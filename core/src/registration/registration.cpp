@@ -159,13 +159,10 @@ Eigen::Matrix4d to_file_frames(const Eigen::Matrix4d& local, const Eigen::Vector
 
 // Without free space (objects) a true pose explains about the overlap: well supported, and the search
 // for more stops, at min(0.6, 0.75 x overlap). With free space the points the target scanner could not
-// see are no evidence either way, so a true pose explains nearly all the rest: refined scores of true poses
-// 0.95-1.00 on every simulated scene, at 0.4 to 1.5 M points. One that explains less than 0.9 of it is not
-// taken as the truth, however well it beats its rivals (the monument's wrong poses where 4PCS had missed
-// the truth: 0.6-0.9).
+// see are no evidence either way, so a true pose explains nearly all the rest (kWellSupportedWithFreeSpace,
+// symmetry_guard.h).
 // Without free space, an intensity pose below this meets the geometric signal's best.
 constexpr double kSignalFallback = 0.6;
-constexpr double kWellSupportedWithFreeSpace = 0.9;
 // With free space an intensity pose below what true poses reach leaves room for a better one: the geometric
 // signal gets its turn. Outdoors the intensity keypoints barely repeat, and their best pose can explain 0.85
 // of the evidence from a tenth of the scans in overlap, 34 m off, or 0.90 turned by 66 degrees.

@@ -80,7 +80,7 @@ std::vector<Eigen::Matrix4d> half_turns(const Eigen::Matrix3Xd& axes, const Eige
 ScoredSource scored_source(const IcpPyramid::Stage& stage, std::size_t max_points) {
   ScoredSource scored;
   scored.points = every_kth(stage.points, max_points);
-  // Only grazing or not is asked of these normals: a voxel's nearest neighbours (about 8 on a plane) will do.
+  // Only the rough incidence is asked of these normals: a voxel's nearest neighbours (about 8 on a plane) will do.
   const double radius_m = 1.5 * stage.voxel_m;
   scored.normals = estimate_normals(scored.points, stage.points, NeighborGrid(stage.points, radius_m), radius_m);
   return scored;
@@ -89,8 +89,9 @@ ScoredSource scored_source(const IcpPyramid::Stage& stage, std::size_t max_point
 // Without views: the share of source points with a target point within tau. With the target's free
 // space, a point is also consistent where it lies at the target scanner's first return in its
 // direction (sparse far surfaces have gaps wider than tau), contradicted where the target scanner saw
-// through it, and no evidence either way where that scanner could not see it (behind its first return,
-// or no return) or where the two scanners saw its surface from opposite sides. Counting unseen points
+// through it or saw open sky around it (where its surface would have faced that scanner), and no
+// evidence either way where that scanner could not see it (behind its first return, or no return) or
+// where the two scanners saw its surface from opposite sides. Counting unseen points
 // as misses favours the pose that maps one scanner's occlusion shadows onto the other's — in a
 // symmetric room, the flip. So the score is, of the points with evidence, the share consistent less
 // the share contradicted. A point whose surface the target scanner would meet at grazing incidence is no
@@ -99,6 +100,9 @@ ScoredSource scored_source(const IcpPyramid::Stage& stage, std::size_t max_point
 double cloud_score(const ScoredSource& scored, const IcpPyramid::Stage& reference, const NeighborGrid& grid,
                    float tau, const Eigen::Matrix4d& t, const ScanViews* views, double overlap) {
   constexpr float kVisibleCos = 0.1f;  // incidence within about 84 degrees of the surface normal
+  // Open sky contradicts only a surface that would have faced the scanner (within 60 degrees): obliquely
+  // seen facade tops and dark surfaces far away return nothing, and a true pose puts points there.
+  constexpr float kFacingCos = 0.5f;
   const std::vector<Eigen::Vector3f>& source = scored.points;
   const Eigen::Affine3f a = to_affine3f(t);
   const Eigen::Vector3f source_scanner = views ? Eigen::Vector3f(a * views->source_scanner_m) : Eigen::Vector3f::Zero();
@@ -119,11 +123,14 @@ double cloud_score(const ScoredSource& scored, const IcpPyramid::Stage& referenc
             continue;
           }
           if (!views) continue;
-          switch (views->target_free_space->classify(q)) {
+          const FreeSpaceImage::Seen seen = views->target_free_space->classify(q);
+          switch (seen) {
             case FreeSpaceImage::Seen::kSurface: ++c.consistent; break;
-            case FreeSpaceImage::Seen::kEmpty: {
+            case FreeSpaceImage::Seen::kEmpty:
+            case FreeSpaceImage::Seen::kOpen: {
               const Eigen::Vector3f ray = q - views->target_scanner_m;
-              const bool visible = std::abs((a.linear() * scored.normals[i]).dot(ray)) >= kVisibleCos * ray.norm();
+              const float cos_needed = seen == FreeSpaceImage::Seen::kOpen ? kFacingCos : kVisibleCos;
+              const bool visible = std::abs((a.linear() * scored.normals[i]).dot(ray)) >= cos_needed * ray.norm();
               ++(visible ? c.contradicted : c.unseen);
               break;
             }
@@ -254,14 +261,25 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
       const Eigen::Matrix4d best = hypotheses.front().transform;
       const bool twins_only = !among(twinned, best);
       if (!twins_only && (!periodic || decisive() || among(shifted, best))) break;
-      (twins_only ? twinned : shifted).push_back(best);
+      // With free space, a best that is not well supported may be a wrong pose that outscored a flip of the
+      // truth: the runner-up's twins compete too.
+      std::vector<Eigen::Matrix4d> expanded{best};
+      if (twins_only && views && hypotheses.front().cloud_score < kWellSupportedWithFreeSpace) {
+        const auto rival = std::find_if(hypotheses.begin() + 1, hypotheses.end(), [&](const Hypothesis& h) {
+          return distinct_transforms(best, h.transform, 2.0, 2.0 * voxel_m);
+        });
+        if (rival != hypotheses.end() && !among(twinned, rival->transform)) expanded.push_back(rival->transform);
+      }
       std::vector<Hypothesis> twins;
-      std::vector<Eigen::Matrix4d> turned;  // the rotations to vote at: target -> target maps composed with best
-      if (twins_only)
-        for (const Eigen::Matrix4d& s : principal_turns) twins.push_back(twin(s * best));
-      else
-        turned.push_back(best);
-      for (const Eigen::Matrix4d& s : normal_turns) turned.push_back(s * best);
+      std::vector<Eigen::Matrix4d> turned;  // the rotations to vote at: target -> target maps composed with a pose
+      for (const Eigen::Matrix4d& pose : expanded) {
+        (twins_only ? twinned : shifted).push_back(pose);
+        if (twins_only)
+          for (const Eigen::Matrix4d& s : principal_turns) twins.push_back(twin(s * pose));
+        else
+          turned.push_back(pose);
+        for (const Eigen::Matrix4d& s : normal_turns) turned.push_back(s * pose);
+      }
       const std::size_t peaks = twins_only ? kTwinShifts : kPeriodicShifts;
       // One vote per rotation (1500 x 1500 pairs each), side by side.
       std::vector<std::vector<Eigen::Vector3d>> shifts(turned.size());

@@ -18,8 +18,13 @@ class FreeSpaceImage {
   FreeSpaceImage(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& scanner_m, double margin_m);
 
   enum class Seen {
-    kUnknown,   // no return in that direction (sky, windows, beyond range) or too near the scanner
+    kUnknown,   // no return in that direction (a window, beyond its reach, outside its field of view) or too
+                // near the scanner
     kEmpty,     // q lies in space the scanner saw to be empty: a contradiction
+    kOpen,      // no return around that direction at all, where the scanner looked (within the band of
+                // elevations it returned from), q nearer than the range it reaches elsewhere: open sky over
+                // a plaza. A contradiction too, unless the surface at q faces the scanner obliquely or is
+                // dark: such surfaces return nothing from afar, so the caller weighs the incidence.
     kSurface,   // q lies at the first return, within the margin
     kOccluded,  // q lies behind the first return
   };
@@ -31,10 +36,14 @@ class FreeSpaceImage {
 
  private:
   int cell(const Eigen::Vector3f& direction) const;
+  void mark_open(const std::vector<float>& own, const std::vector<std::size_t>& per_row, std::size_t returns,
+                 std::vector<float>& sampled_ranges);
   Eigen::Vector3f scanner_;
   float margin_;
   int elevation_cells_, azimuth_cells_;  // from the point count: a few returns per cell
   std::vector<float> nearest_;  // nearest return per (azimuth, elevation) cell; +inf where none
+  std::vector<bool> open_;      // no return in a wide neighbourhood, within the band of elevations seen
+  float reach_m_ = 0;           // a range the scanner returns from (99th percentile of its ranges)
 };
 
 }  // namespace k4reg
