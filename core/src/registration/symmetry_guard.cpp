@@ -236,11 +236,15 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
     const std::vector<Eigen::Matrix4d> principal_turns = axes(point_axes(coarse_target.points, centre));
     const std::vector<Eigen::Matrix4d> normal_turns = axes(normal_axes(coarse_target.normals));
     // Whether the best hypothesis beats the first distinct one by the margin a result needs.
+    // The first hypothesis after the best that is a distinct pose.
+    auto first_rival = [&] {
+      return std::find_if(hypotheses.begin() + 1, hypotheses.end(), [&](const Hypothesis& h) {
+        return distinct_transforms(hypotheses.front().transform, h.transform, 2.0, 2.0 * voxel_m);
+      });
+    };
     auto decisive = [&] {
       const Hypothesis& best = hypotheses.front();
-      const auto rival = std::find_if(hypotheses.begin() + 1, hypotheses.end(), [&](const Hypothesis& h) {
-        return distinct_transforms(best.transform, h.transform, 2.0, 2.0 * voxel_m);
-      });
+      const auto rival = first_rival();
       return rival == hypotheses.end() || best.cloud_score <= 0 ||
              (best.cloud_score - rival->cloud_score) / best.cloud_score >= kAmbiguousMargin;
     };
@@ -265,9 +269,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
       // truth: the runner-up's twins compete too.
       std::vector<Eigen::Matrix4d> expanded{best};
       if (twins_only && views && hypotheses.front().cloud_score < kWellSupportedWithFreeSpace) {
-        const auto rival = std::find_if(hypotheses.begin() + 1, hypotheses.end(), [&](const Hypothesis& h) {
-          return distinct_transforms(best, h.transform, 2.0, 2.0 * voxel_m);
-        });
+        const auto rival = first_rival();
         if (rival != hypotheses.end() && !among(twinned, rival->transform)) expanded.push_back(rival->transform);
       }
       std::vector<Hypothesis> twins;

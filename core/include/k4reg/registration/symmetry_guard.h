@@ -4,10 +4,9 @@
 // covers, less how much of it lands in space the target scanner saw to be empty (points the target
 // scanner could not see, saw from the other side of their surface, or would meet at grazing incidence,
 // are no evidence). 4PCS on a symmetric room often finds only the flipped pose, so the best hypothesis's
-// twins (and, where the best is not well supported, the runner-up's) under half turns
-// compete too: about the target's principal axes through its centre, and about
-// the axes of its normals, shifted to where a translation vote on normal-space samples puts them
-// (translation_vote.h). On request (periodic), a twin that wins gets its own twins and, while no hypothesis
+// twins (and, where the best is not well supported, the runner-up's) under half turns compete too: about
+// the target's principal axes through its centre, and about the axes of its normals, shifted to where a
+// translation vote on normal-space samples puts them (translation_vote.h). On request (periodic), a twin that wins gets its own twins and, while no hypothesis
 // stands out, the best also gets shifted copies at the vote's further peaks: periodic scenes (a corridor's
 // doors) repeat under shifts, and 4PCS tends to find the copy that puts one scanner where the other stood.
 // Cost per hypothesis (and per twin: nine per round, and up to 48 shifted copies per periodic round): a
