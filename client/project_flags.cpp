@@ -8,18 +8,23 @@ void add_project_flags(CLI::App& command, ProjectFlags& flags, ProjectParams& pa
   flags.reference = command.add_option("--reference", params.reference, "0-based index of the scan whose pose is the identity")
                         ->capture_default_str();
   command.add_option("--pairs", flags.pairs,
-                     "which pairs to register: all, sequence (each scan with the next two), or a file of index pairs")
+                     "which pairs to register: auto (all up to " + std::to_string(kAllPairsUpTo) +
+                         " scans, screened beyond), all, sequence (each scan with the next two), screened (each scan's "
+                         "best partners by a cheap overlap estimate of every pair), or a file of index pairs")
       ->capture_default_str();
+  flags.partners = command.add_option("--partners", params.partners, "with screened pairs: partners registered per scan")
+                       ->check(CLI::PositiveNumber)
+                       ->capture_default_str();
   command.add_flag("--json", flags.json, "print the result as JSON");
   command.add_option("--out-dir", flags.out_dir, "write NAME.pose.txt per registered scan and project.json here");
 }
 
 void apply_pairs(const ProjectFlags& flags, ProjectParams& params) {
-  if (flags.pairs == "all") {
-    params.pairs = PairSelection::kAll;
-  } else if (flags.pairs == "sequence") {
-    params.pairs = PairSelection::kSequence;
-  } else {
+  bool named = false;
+  for (PairSelection selection :
+       {PairSelection::kAuto, PairSelection::kAll, PairSelection::kSequence, PairSelection::kScreened})
+    if (flags.pairs == to_string(selection)) params.pairs = selection, named = true;
+  if (!named) {
     params.pairs = PairSelection::kList;
     params.pair_list = read_pair_list(flags.pairs);
   }

@@ -1,6 +1,7 @@
 #include "project_mapping.h"
 
 #include "messages_to_core.h"
+#include "pair_selection.h"
 #include "proto_mapping.h"
 
 namespace k4reg::cli {
@@ -55,6 +56,8 @@ ProjectResult project_result_from_proto(const v1::ProjectResult& m) {
   r.loops_checked = m.loops_checked();
   r.loops_inconsistent = m.loops_inconsistent();
   r.global_rmse_m = m.global_rmse_m();
+  r.pairs_used = api::pair_selection_from_proto(m.pairs_used());
+  r.pairs_screened = m.pairs_screened();
   for (const v1::StageTiming& t : m.timings()) r.timings.push_back({t.stage(), t.seconds()});
   return r;
 }

@@ -68,12 +68,14 @@ nlohmann::json project_to_json(const ProjectResult& r, const std::vector<ScanOri
   j["loops_checked"] = r.loops_checked;
   j["loops_inconsistent"] = r.loops_inconsistent;
   j["global_rmse_m"] = r.global_rmse_m;
+  j["pairs_used"] = to_string(r.pairs_used);
+  j["pairs_screened"] = r.pairs_screened;
   j["timings"] = timings_to_json(r.timings);
-  const char* pairs[] = {"all", "sequence", "list"};
   j["params"] = {{"min_scale_m", params.pairwise.min_scale_m},
                  {"overlap", params.pairwise.overlap},
                  {"reference", params.reference},
-                 {"pairs", pairs[static_cast<int>(params.pairs)]},
+                 {"pairs", to_string(params.pairs)},
+                 {"partners", params.partners},
                  {"levelled", params.pairwise.levelled},
                  {"seed", params.pairwise.seed}};
   return j;

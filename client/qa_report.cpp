@@ -71,9 +71,9 @@ void write_project_report(const ReportFlags& flags, const std::string& generator
   document.generator = generator;
   document.files = scans;
   document.parameters = params_to_json(params.pairwise);
-  const char* pairs[] = {"all", "sequence", "list"};
   document.parameters["reference"] = params.reference;
-  document.parameters["pairs"] = pairs[static_cast<int>(params.pairs)];
+  document.parameters["pairs"] = to_string(params.pairs);
+  document.parameters["partners"] = params.partners;
   document.result = result;
   document.preview = preview;
   web::write_report(flags.path, document);

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <memory>
 
+#include "pair_selection.h"
 #include "channel.h"
 #include "command_error.h"
 #include "k4reg/v1/registration.grpc.pb.h"
@@ -52,9 +53,8 @@ v1::ProjectUploadHeader make_header(const RegisterProjectOptions& o, ProjectPara
   v1::ProjectParams& p = *header.mutable_params();
   *p.mutable_pairwise() = params_to_proto(params.pairwise, o.registration);
   if (o.flags.reference->count() > 0) p.set_reference(static_cast<std::uint32_t>(params.reference));
-  p.set_pairs(params.pairs == PairSelection::kAll        ? v1::PAIR_SELECTION_ALL
-              : params.pairs == PairSelection::kSequence ? v1::PAIR_SELECTION_SEQUENCE
-                                                         : v1::PAIR_SELECTION_LIST);
+  p.set_pairs(api::pair_selection_to_proto(params.pairs));
+  if (o.flags.partners->count() > 0) p.set_partners(static_cast<std::uint32_t>(params.partners));
   for (const auto& [first, second] : params.pair_list) {
     v1::ScanPair& pair = *p.add_pair_list();
     pair.set_first(static_cast<std::uint32_t>(first));

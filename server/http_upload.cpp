@@ -16,19 +16,19 @@ namespace {
 
 // The parameter named `name`: where it goes in the request, and its field there.
 struct FormField {
-  bool project_level = false;  // a ProjectParams field (reference, pairs) rather than a RegistrationParams one
+  bool project_level = false;  // a ProjectParams field (reference, pairs, partners) rather than a RegistrationParams one
   const google::protobuf::FieldDescriptor* field = nullptr;
 };
 
 FormField form_field(const std::string& name, FormKind kind) {
-  if (kind == FormKind::kProject && (name == "reference" || name == "pairs"))
+  if (kind == FormKind::kProject && (name == "reference" || name == "pairs" || name == "partners"))
     return {true, v1::ProjectParams::descriptor()->FindFieldByName(name)};
   const google::protobuf::FieldDescriptor* field = v1::RegistrationParams::descriptor()->FindFieldByName(name);
   if (!field)
     fail(ErrorCode::kInvalidArgument,
          fmt::format("unknown form field '{}': expected {}, preview_points{} or a RegistrationParams field "
                      "(min_scale_m, overlap, seed, ...)",
-                     name, kind == FormKind::kPair ? "source, target" : "scans", kind == FormKind::kPair ? "" : ", reference, pairs"));
+                     name, kind == FormKind::kPair ? "source, target" : "scans", kind == FormKind::kPair ? "" : ", reference, pairs, partners"));
   return {false, field};
 }
 
@@ -39,7 +39,8 @@ nlohmann::json json_value(const google::protobuf::FieldDescriptor& field, const 
   if (field.cpp_type() == FieldDescriptor::CPPTYPE_BOOL && (value == "true" || value == "false")) return value == "true";
   if (field.cpp_type() == FieldDescriptor::CPPTYPE_ENUM) {
     if (!value.empty() && value.find_first_not_of("0123456789") == std::string::npos) return std::stoi(value.substr(0, 9));
-    if (field.enum_type() == v1::PairSelection_descriptor() && (value == "all" || value == "sequence" || value == "list")) {
+    if (field.enum_type() == v1::PairSelection_descriptor() && (value == "all" || value == "sequence" || value == "list" ||
+                                                                value == "screened" || value == "auto")) {
       std::string upper = value;
       for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
       return "PAIR_SELECTION_" + upper;

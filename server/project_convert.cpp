@@ -1,6 +1,7 @@
 #include "project_convert.h"
 
 #include "k4reg/util/error.h"
+#include "pair_selection.h"
 #include "proto_convert.h"
 
 namespace k4reg::service {
@@ -15,23 +16,14 @@ ProjectParams project_params_from_proto(const v1::ProjectParams& m) {
     throw Error(e.code(), message.rfind("params.", 0) == 0 ? "params.pairwise." + message.substr(7) : message);
   }
   if (m.has_reference()) p.reference = m.reference();
-  switch (m.pairs()) {
-    case v1::PAIR_SELECTION_UNSPECIFIED:
-    case v1::PAIR_SELECTION_ALL:
-      p.pairs = PairSelection::kAll;
-      break;
-    case v1::PAIR_SELECTION_SEQUENCE:
-      p.pairs = PairSelection::kSequence;
-      break;
-    case v1::PAIR_SELECTION_LIST:
-      p.pairs = PairSelection::kList;
-      break;
-    default:
-      fail(ErrorCode::kInvalidArgument, "params.pairs: unknown value " + std::to_string(m.pairs()));
-  }
+  p.pairs = api::pair_selection_from_proto(m.pairs());
   if (p.pairs != PairSelection::kList && m.pair_list_size() > 0)
     fail(ErrorCode::kInvalidArgument, "params.pair_list is only for pairs = PAIR_SELECTION_LIST");
   for (const v1::ScanPair& pair : m.pair_list()) p.pair_list.emplace_back(pair.first(), pair.second());
+  if (m.has_partners()) {
+    if (m.partners() == 0) fail(ErrorCode::kInvalidArgument, "params.partners must be at least 1");
+    p.partners = m.partners();
+  }
   return p;
 }
 
@@ -84,6 +76,8 @@ void project_result_to_proto(const ProjectResult& r, const std::vector<std::stri
   m->set_loops_checked(static_cast<std::uint32_t>(r.loops_checked));
   m->set_loops_inconsistent(static_cast<std::uint32_t>(r.loops_inconsistent));
   m->set_global_rmse_m(r.global_rmse_m);
+  m->set_pairs_used(api::pair_selection_to_proto(r.pairs_used));
+  m->set_pairs_screened(static_cast<std::uint32_t>(r.pairs_screened));
   for (const StageTiming& t : r.timings) {
     v1::StageTiming& out = *m->add_timings();
     out.set_stage(t.stage);

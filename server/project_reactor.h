@@ -1,5 +1,5 @@
 // RegisterProject (server streaming): the request names or carries every scan; the job runs on a worker,
-// which posts the queued event, stage events ("load", "pairs", "selection", "refinement"), one event per
+// which posts the queued event, stage events ("load", "screen", "pairs", "selection", "refinement"), one event per
 // registered pair, and finally the result, through the outbox (job_stream_reactor.h).
 #pragma once
 

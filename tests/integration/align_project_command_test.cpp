@@ -95,6 +95,18 @@ TEST(AlignProjectCommand, SequencePairsAndTableOutput) {
   EXPECT_NE(run.out.find("3 of 3 scans registered"), std::string::npos) << run.out;
 }
 
+TEST(AlignProjectCommand, ScreenedPairsSayWhatRanInTheJson) {
+  const CommandRun run = k4reg(with_flags({"align-project", bunny("bun000.ply"), bunny("bun045.ply"), bunny("bun315.ply"),
+                                           "--pairs", "screened", "--partners", "1", "--json"}));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j["pairs_used"], "screened");
+  EXPECT_EQ(j["pairs_screened"], 3);
+  EXPECT_EQ(j["params"]["partners"], 1);
+  const CommandRun zero = k4reg(with_flags({"align-project", bunny("bun000.ply"), bunny("bun045.ply"), "--partners", "0"}));
+  EXPECT_NE(zero.exit_code, 0);
+}
+
 TEST(AlignProjectCommand, MalformedProjectsAreOneLineAndExitOne) {
   TempDir dir;
   const std::string garbage = (dir.path() / "garbage.ply").string();

@@ -120,7 +120,9 @@ TEST_F(HttpEvents, RefusalsBeforeTheJobAreStatusesAndFailuresAfterItAreErrorEven
 TEST_F(HttpEvents, ProjectUploadIsTheJsonProjectWithPairEventsAndAPreview) {
   std::vector<std::string> args{"-N", "-H", "Accept: application/x-ndjson"};
   for (const std::string& scan : kProject) args.insert(args.end(), {"-F", "scans=@" + (bunny_dir() / scan).string()});
-  for (const char* field : {"min_scale_m=0.002", "overlap=0.5", "seed=1", "pairs=all", "reference=0", "preview_points=3000"})
+  // Screened pairs by their short name: with 2 partners each of the 3 scans keeps both others, so all 3 pairs run.
+  for (const char* field :
+       {"min_scale_m=0.002", "overlap=0.5", "seed=1", "pairs=screened", "partners=2", "reference=0", "preview_points=3000"})
     args.insert(args.end(), {"-F", field});
   args.push_back(url("/v1/register-project"));
   const HttpReply reply = curl(args);
@@ -136,15 +138,21 @@ TEST_F(HttpEvents, ProjectUploadIsTheJsonProjectWithPairEventsAndAPreview) {
   ASSERT_EQ(uploaded.preview().clouds_size(), 3);
   EXPECT_EQ(uploaded.preview().clouds(1).name(), "bun045.ply");
   EXPECT_EQ(preview_points(uploaded.preview()), 3000u);
+  EXPECT_EQ(uploaded.result().pairs_used(), v1::PAIR_SELECTION_SCREENED);
+  EXPECT_EQ(uploaded.result().pairs_screened(), 3u);
 
   // The same scans by path as JSON, answered at once.
-  nlohmann::json body = {{"params", {{"pairwise", {{"min_scale_m", 0.002}, {"overlap", 0.5}, {"seed", "1"}}}}}};
+  nlohmann::json body = {{"params",
+                          {{"pairwise", {{"min_scale_m", 0.002}, {"overlap", 0.5}, {"seed", "1"}}},
+                           {"pairs", "PAIR_SELECTION_SCREENED"},
+                           {"partners", 2}}}};
   for (const std::string& scan : kProject) body["scans"].push_back({{"path", scan}});
   const HttpReply json = curl({"-H", "Content-Type: application/json", "--data-binary", body.dump(), url("/v1/register-project")});
   ASSERT_EQ(json.status, 200) << json.body;
   v1::RegisterProjectResponse by_path;
   service::from_json(json.body, by_path);
   EXPECT_FALSE(by_path.has_preview());
+  EXPECT_EQ(by_path.result().pairs_used(), v1::PAIR_SELECTION_SCREENED);
   ASSERT_EQ(by_path.result().scans_size(), 3);
   for (int s = 0; s < 3; ++s) {
     ASSERT_EQ(uploaded.result().scans(s).pose_size(), by_path.result().scans(s).pose_size());
@@ -162,6 +170,7 @@ TEST_F(HttpEvents, MalformedProjectFormsAreRefused) {
       {{scan}, "at least 2 scans"},
       {{scan, "scans=bun045.ply", "reference=5"}, "out of range"},
       {{scan, "scans=bun045.ply", "pairs=sometimes"}, "pairs"},
+      {{scan, "scans=bun045.ply", "partners=0"}, "partners"},
       {{scan, "scans=../etc/passwd"}, ""},
       {{scan, "scans=bun045.ply", "source=bun090.ply"}, "unknown form field 'source'"},
       {{scan, "scans=bun045.ply", "preview_points=lots"}, "preview_points"},

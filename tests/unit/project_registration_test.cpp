@@ -83,6 +83,8 @@ TEST(ProjectRegistration, BunnyScansAllRegisteredWithinAMillimetre) {
     EXPECT_NEAR(r.scans[i].constraint.trace(), 3.0, 1e-9) << bunny.files[i];
     EXPECT_GT(weakest_constraint(r.scans[i].constraint), 0.2) << bunny.files[i];
   }
+  EXPECT_EQ(r.pairs_used, PairSelection::kAll);  // the default, auto, at 6 scans
+  EXPECT_EQ(r.pairs_screened, 0u);
   EXPECT_EQ(r.links.size(), 15u);
   EXPECT_EQ(r.loops_checked, 20u);
   EXPECT_GT(r.global_rmse_m, 0.0);
@@ -104,6 +106,25 @@ TEST(ProjectRegistration, BunnyScansAllRegisteredWithinAMillimetre) {
     return std::any_of(r.timings.begin(), r.timings.end(), [&](const StageTiming& t) { return t.stage == name; });
   };
   EXPECT_TRUE(stage("keypoints") && stage("selection") && stage("refinement"));
+}
+
+TEST(ProjectRegistration, ScreenedPairsRegisterEachScanWithItsBestPartners) {
+  const BunnyProject bunny;
+  ProjectParams params = statue_params();
+  params.pairs = PairSelection::kScreened;
+  params.partners = 3;
+  const ProjectResult r = register_project(bunny.scans, params);
+  EXPECT_EQ(r.pairs_used, PairSelection::kScreened);
+  EXPECT_EQ(r.pairs_screened, 15u);
+  EXPECT_LT(r.links.size(), 15u);
+  EXPECT_GE(r.links.size(), 6u);  // every scan in a pair, and the pairs connect them all
+  for (std::size_t i = 0; i < 6; ++i) {
+    EXPECT_TRUE(r.scans[i].registered) << bunny.files[i] << ": " << r.scans[i].reason;
+    EXPECT_LT(rms_error_m(bunny.scans[i], r.scans[i].pose, bunny.truth[i]), 0.001) << bunny.files[i];
+  }
+  EXPECT_TRUE(std::any_of(r.timings.begin(), r.timings.end(), [](const StageTiming& t) { return t.stage == "screen"; }));
+  params.partners = 0;
+  EXPECT_THROW(register_project(bunny.scans, params), Error);
 }
 
 TEST(ProjectRegistration, ScanOfAnotherObjectIsNotRegisteredAndTheRestStill) {

@@ -32,8 +32,27 @@ std::vector<ScanPair> candidate_pairs(std::size_t scans, PairSelection selection
       std::sort(pairs.begin(), pairs.end());
       pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
       break;
+    case PairSelection::kScreened:
+    case PairSelection::kAuto:
+      fail(ErrorCode::kInvalidArgument, std::string("pairs ") + to_string(selection) + " need the scans (partner_screen.h)");
   }
   return pairs;
+}
+
+PairSelection resolved(PairSelection selection, std::size_t scans) {
+  if (selection != PairSelection::kAuto) return selection;
+  return scans <= kAllPairsUpTo ? PairSelection::kAll : PairSelection::kScreened;
+}
+
+const char* to_string(PairSelection selection) {
+  switch (selection) {
+    case PairSelection::kAll: return "all";
+    case PairSelection::kSequence: return "sequence";
+    case PairSelection::kList: return "list";
+    case PairSelection::kScreened: return "screened";
+    case PairSelection::kAuto: return "auto";
+  }
+  return "?";
 }
 
 std::vector<ScanPair> read_pair_list(const std::string& path) {

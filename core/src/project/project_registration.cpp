@@ -11,6 +11,7 @@
 #include "k4reg/geometry/rigid_motion.h"
 #include "k4reg/geometry/sampling.h"
 #include "k4reg/project/loop_closure.h"
+#include "k4reg/project/partner_screen.h"
 #include "k4reg/project/pose_graph.h"
 #include "k4reg/project/scan_conflicts.h"
 #include "k4reg/project/scan_strength.h"
@@ -157,6 +158,24 @@ LinkCandidates link_from_outcome(const PairOutcome& outcome, const ScanPair& pai
   return c;
 }
 
+// The scans that no loop of the pairs registered so far confirms (a first loop selection, milliseconds).
+std::vector<std::size_t> unconfirmed_scans(std::size_t scans, const std::vector<ScanPair>& pairs,
+                                           const std::vector<PairOutcome>& outcomes, const std::vector<double>& radius) {
+  std::vector<LinkCandidates> found;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    ProjectLink scratch;
+    found.push_back(link_from_outcome(outcomes[k], pairs[k], scratch));
+  }
+  const LoopSelectionResult selection = select_loop_consistent(found, radius);
+  std::vector<bool> confirmed(scans, false);
+  for (std::size_t k = 0; k < pairs.size(); ++k)
+    if (selection.links[k].verdict == LinkVerdict::kConfirmed) confirmed[pairs[k].first] = confirmed[pairs[k].second] = true;
+  std::vector<std::size_t> unconfirmed;
+  for (std::size_t i = 0; i < scans; ++i)
+    if (!confirmed[i]) unconfirmed.push_back(i);
+  return unconfirmed;
+}
+
 }  // namespace
 
 ProjectResult register_project(const std::vector<PointCloud>& scans, const ProjectParams& params,
@@ -171,6 +190,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
                      scans.size()));
   for (std::size_t i = 0; i < scans.size(); ++i)
     if (scans[i].empty()) fail(ErrorCode::kInvalidArgument, fmt::format("scan {} is empty", i));
+  if (params.partners == 0) fail(ErrorCode::kInvalidArgument, "partners must be at least 1");
 
   CancellationToken budget(cancel);
   if (params.pairwise.time_budget_s > 0)
@@ -184,21 +204,54 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
   r.scans.resize(scans.size());
   for (std::size_t i = 0; i < scans.size(); ++i) r.scans[i].points = scans[i].size();
 
-  // 1. Pairwise registration, keeping every distinct hypothesis as a candidate for the loops.
-  const std::vector<ScanPair> pairs = candidate_pairs(scans.size(), params.pairs, params.pair_list);
-  std::vector<PairOutcome> outcomes(pairs.size());
-  std::size_t pairs_done = 0;
   // Each scan's voxels, keypoints and pyramids are computed once, in its first pair, and shared by the rest.
   const std::vector<PreparedScan> prepared(scans.begin(), scans.end());
+
+  std::vector<double> radius(scans.size());
+  for (std::size_t i = 0; i < scans.size(); ++i) radius[i] = scan_radius_m(scans[i]);
+
+  // 1. Pairwise registration, keeping every distinct hypothesis as a candidate for the loops. Large projects
+  //    register each scan's best partners only, by a cheap overlap estimate of every pair.
+  r.pairs_used = resolved(params.pairs, scans.size());
+  std::vector<ScanPair> pairs;
+  std::vector<double> estimates;
+  if (r.pairs_used == PairSelection::kScreened) {
+    const auto screen_start = Clock::now();
+    estimates = estimate_overlaps(prepared, pairwise, &budget, progress);
+    pairs = best_partners(scans.size(), estimates, params.partners);
+    r.pairs_screened = estimates.size();
+    add_timing(r.timings, "screen", seconds_since(screen_start));
+  } else {
+    pairs = candidate_pairs(scans.size(), r.pairs_used, params.pair_list);
+  }
+  std::vector<PairOutcome> outcomes;
+  std::size_t pairs_done = 0;
   LocalPairRunner local;
-  (runner ? *runner : local).run(prepared, pairs, pairwise, &budget, [&](std::size_t k, PairOutcome outcome) {
-    outcomes.at(k) = std::move(outcome);
-    ProjectLink link;
-    link_from_outcome(outcomes[k], pairs[k], link);
-    if (on_pair) on_pair(link, pairs_done, pairs.size());
-    ++pairs_done;
-    if (progress) progress("pairs", static_cast<double>(pairs_done) / pairs.size());
-  });
+  // Registers pairs[first...] (wherever the runner sends them).
+  auto register_pairs = [&](std::size_t first) {
+    const std::vector<ScanPair> batch(pairs.begin() + static_cast<std::ptrdiff_t>(first), pairs.end());
+    outcomes.resize(pairs.size());
+    (runner ? *runner : local).run(prepared, batch, pairwise, &budget, [&](std::size_t k, PairOutcome outcome) {
+      outcomes.at(first + k) = std::move(outcome);
+      ProjectLink link;
+      link_from_outcome(outcomes[first + k], pairs[first + k], link);
+      if (on_pair) on_pair(link, pairs_done, pairs.size());
+      ++pairs_done;
+      if (progress) progress("pairs", static_cast<double>(pairs_done) / pairs.size());
+    });
+  };
+  register_pairs(0);
+  // A screened scan that no loop of its first pairs confirms gets its next best partners too, once: the loops
+  // need them to check its links.
+  if (r.pairs_used == PairSelection::kScreened) {
+    const std::vector<std::size_t> extend = unconfirmed_scans(scans.size(), pairs, outcomes, radius);
+    const std::vector<ScanPair> more = more_partners(scans.size(), estimates, pairs, extend, params.partners);
+    if (!more.empty()) {
+      const std::size_t first_new = pairs.size();
+      pairs.insert(pairs.end(), more.begin(), more.end());
+      register_pairs(first_new);
+    }
+  }
   // In the pairs' order, wherever and in whatever order they ran.
   std::vector<LinkCandidates> candidates;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
@@ -209,8 +262,6 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
   }
 
   if (progress) progress("selection", 0.0);
-  std::vector<double> radius(scans.size());
-  for (std::size_t i = 0; i < scans.size(); ++i) radius[i] = scan_radius_m(scans[i]);
 
   // 2a. Weak links judged from both sides: a well-supported winner with a small margin, and its runner-up, are
   //     judged again with the scans swapped, and the two sides' margins add up (two_sided_margin.h).
@@ -286,7 +337,10 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     if (candidates[l].transforms.empty()) continue;  // failed, reason set
     link.verdict = to_string(s.verdict);
     link.candidate = s.candidate;
-    link.accepted = s.accepted();
+    // With screened pairs a link in no loop may owe that to the screen, not to the scene: its scans' other
+    // partners were never registered. Nothing checked it, so it is not taken on its pairwise verdict alone.
+    const bool screened_out_of_loops = r.pairs_used == PairSelection::kScreened && s.verdict == LinkVerdict::kUnchecked;
+    link.accepted = s.accepted() && !screened_out_of_loops;
     if (link.accepted) link.transform = candidates[l].transforms[s.candidate];
     switch (s.verdict) {
       case LinkVerdict::kConfirmed:
@@ -297,7 +351,11 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
       case LinkVerdict::kConsistent:
         link.reason = fmt::format("closes its {} loops, though none alone tells it from a symmetric twin", s.loops);
         break;
-      case LinkVerdict::kUnchecked: link.reason = "in no loop; accepted on its pairwise verdict"; break;
+      case LinkVerdict::kUnchecked:
+        link.reason = screened_out_of_loops
+                          ? "in no loop of the screened pairs, so nothing checks it (pairs all registers every pair)"
+                          : "in no loop; accepted on its pairwise verdict";
+        break;
       case LinkVerdict::kContradicted:
         link.reason = fmt::format("contradicts the loops: none of its {} hypotheses closes any of its {} loops (smallest residual {:.3g} m)",
                                   candidates[l].transforms.size(), s.loops, s.loop_residual_m);

@@ -559,41 +559,32 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   return {std::move(result), supported};
 }
 
+// The start: DoG scales run from sigma to 2^5 sigma, and at diameter / 128 the coarsest octave still sees a
+// quarter of the scene, so a scan of any size and unit yields keypoints at every octave. No coarser than 10
+// point spacings, though (a voxel then averages ~100 points): a large outdoor scene, dense near the scanner,
+// would otherwise start at a scale that only its far field needs.
+constexpr double kDiameterPerScale = 128.0;
+constexpr double kSpacingsPerScale = 10.0;
+
 // The scales to try, coarsest first: the caller's or the automatic start, halved while a scale finds
 // too few keypoints or no well-supported pose, down to the point spacing.
 class ScaleLadder {
  public:
   ScaleLadder(const PreparedScan& source, const PreparedScan& target, double min_scale_m)
-      : source_(source), target_(target), start_m_(min_scale_m) {
-    if (start_m_ == 0.0) {
-      const Sampling &s = source.sampling(), &t = target.sampling();
-      spacing_m_ = std::max(s.spacing_m, t.spacing_m);
-      const double coarsest = std::min(s.diameter_m, t.diameter_m) / kDiameterPerScale;
-      start_m_ = std::max(std::min(coarsest, kSpacingsPerScale * spacing_m_), 2.0 * spacing_m_);
-      if (!(start_m_ > 0.0))
-        fail(ErrorCode::kInvalidArgument, "the clouds have no extent: all points coincide");
-    }
-  }
+      : source_(source), target_(target), start_m_(starting_scale_m(source, target, min_scale_m)) {}
   double start_m() const { return start_m_; }
   // The scale after `scale_m`, or 0 when none is left.
   double next(double scale_m, int tried) {
     if (tried >= kMaxScales) return 0.0;
-    if (spacing_m_ < 0) spacing_m_ = std::max(source_.sampling().spacing_m, target_.sampling().spacing_m);
-    return 0.5 * scale_m >= spacing_m_ ? 0.5 * scale_m : 0.0;
+    const double spacing_m = std::max(source_.sampling().spacing_m, target_.sampling().spacing_m);
+    return 0.5 * scale_m >= spacing_m ? 0.5 * scale_m : 0.0;
   }
 
  private:
-  // The start: DoG scales run from sigma to 2^5 sigma, and at diameter / 128 the coarsest octave still
-  // sees a quarter of the scene, so a scan of any size and unit yields keypoints at every octave. No
-  // coarser than 10 point spacings, though (a voxel then averages ~100 points): a large outdoor scene,
-  // dense near the scanner, would otherwise start at a scale that only its far field needs.
-  static constexpr double kDiameterPerScale = 128.0;
-  static constexpr double kSpacingsPerScale = 10.0;
   static constexpr int kMaxScales = 4;
   const PreparedScan& source_;
   const PreparedScan& target_;
   double start_m_;
-  double spacing_m_ = -1.0;  // measured when first needed
 };
 
 // Stage timings of two attempts added up, stage by stage.
@@ -637,6 +628,16 @@ RegistrationResult run(const PreparedScan& source, const PreparedScan& target, c
 }
 
 }  // namespace
+
+double starting_scale_m(const PreparedScan& source, const PreparedScan& target, double min_scale_m) {
+  if (min_scale_m > 0.0) return min_scale_m;
+  const Sampling &s = source.sampling(), &t = target.sampling();
+  const double spacing_m = std::max(s.spacing_m, t.spacing_m);
+  const double coarsest = std::min(s.diameter_m, t.diameter_m) / kDiameterPerScale;
+  const double start_m = std::max(std::min(coarsest, kSpacingsPerScale * spacing_m), 2.0 * spacing_m);
+  if (!(start_m > 0.0)) fail(ErrorCode::kInvalidArgument, "the clouds have no extent: all points coincide");
+  return start_m;
+}
 
 RegistrationResult register_clouds(const PointCloud& source, const PointCloud& target, const RegistrationParams& params,
                                    const CancellationToken* cancel, const ProgressCallback& progress) {

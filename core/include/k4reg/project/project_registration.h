@@ -1,6 +1,7 @@
 // Project registration: N scans into one frame (after Theiler, Wegner, Schindler 2015), top to bottom:
-//   candidate pairs (candidate_pairs.h)  ->  pairwise K-4PCS per pair, keeping its distinct hypotheses
-//   ->  links whose well-supported winner has a small margin judged from both sides (two_sided_margin.h)
+//   candidate pairs (candidate_pairs.h; for large projects each scan's best partners, partner_screen.h)
+//   ->  pairwise K-4PCS per pair, keeping its distinct hypotheses (screened: then the next best partners of scans
+//   no loop confirms)  ->  links whose well-supported winner has a small margin judged from both sides (two_sided_margin.h)
 //   ->  loop-consistent selection of one hypothesis per link (loop_closure.h)  ->  where a loop stays open,
 //   the poses its links imply judged on each link's own clouds (judge_poses), and the selection again
 //   ->  initial poses by consensus of the accepted links, from the reference out  ->  conflicts, minority
@@ -9,7 +10,8 @@
 // A scan that no majority of accepted links places, or that they hold too weakly to tell it from a
 // symmetric twin, is reported as not registered, never forced into place. Pairs run one after the other, each on all
 // threads (or wherever a PairRunner sends them), so the result is the same at any thread count and on any runner.
-// Cost: one pairwise registration per candidate pair (0.2-3 s each at 1 M points on 2 cores); judging implied
+// Cost: for screened pairs, one 4PCS round on keypoints per pair of scans (about 0.1 s at 1 M points); one
+// pairwise registration per candidate pair (0.2-3 s each at 1 M points on 2 cores); judging implied
 // poses, a guard and a verdict per link in an open loop of well-supported links (0.1-1 s each), and as much per
 // weak link judged from both sides (2-4 s at 0.7 M points); selection and refinement take milliseconds.
 #pragma once
@@ -33,8 +35,9 @@ struct ProjectParams {
   // Every pair runs with this seed, so a link equals `k4reg align` on the same two scans.
   RegistrationParams pairwise;
   std::size_t reference = 0;  // the scan whose pose is the identity
-  PairSelection pairs = PairSelection::kAll;
+  PairSelection pairs = PairSelection::kAuto;  // all pairs up to kAllPairsUpTo scans, screened beyond
   std::vector<ScanPair> pair_list;  // for PairSelection::kList
+  std::size_t partners = 4;         // for PairSelection::kScreened: partners registered per scan (>= 1)
 };
 
 struct ProjectLink {
@@ -87,10 +90,13 @@ struct ProjectResult {
   std::vector<ProjectScan> scans;
   std::vector<ProjectLink> links;
   std::size_t reference = 0;
+  PairSelection pairs_used = PairSelection::kAll;  // the selection the pairs came from (kAuto resolved)
+  std::size_t pairs_screened = 0;                  // pairs whose overlap the screen estimated (kScreened)
   std::size_t scans_registered = 0;
   std::size_t loops_checked = 0, loops_inconsistent = 0;
   double global_rmse_m = 0.0;  // RMS of the accepted links' misfits after the global refinement
-  std::vector<StageTiming> timings;  // pairwise stages summed over pairs, then "selection", "refinement"
+  // "screen" (kScreened), the pairwise stages summed over pairs, then "selection", "refinement"
+  std::vector<StageTiming> timings;
 };
 
 // What a true link's transform can be off by (metres of scan displacement): its fine-scale error, or twice
@@ -101,8 +107,8 @@ double link_tolerance_m(const ProjectLink& link);
 // number of pairs.
 using PairCallback = std::function<void(const ProjectLink& link, std::size_t index, std::size_t pairs)>;
 
-// Throws kInvalidArgument for fewer than 2 scans, an empty scan, a reference out of range or bad pairwise
-// parameters; kCancelled / kDeadlineExceeded when stopped (time_budget_s of the pairwise parameters bounds
+// Throws kInvalidArgument for fewer than 2 scans, an empty scan, a reference out of range, partners 0 or bad
+// pairwise parameters; kCancelled / kDeadlineExceeded when stopped (time_budget_s of the pairwise parameters bounds
 // the whole project). A pair that cannot be registered is a failed link, not an error.
 // `runner` registers the pairs (pair_runner.h); null = one after the other in this process. The poses do not
 // depend on it.

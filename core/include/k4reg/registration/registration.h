@@ -152,6 +152,10 @@ RegistrationResult register_clouds(const PreparedScan& source, const PreparedSca
                                    const RegistrationParams& params, const CancellationToken* cancel = nullptr,
                                    const ProgressCallback& progress = {});
 
+// The scale register_clouds starts from: min_scale_m when given (> 0), else the automatic start from the two
+// scans' sampling. Throws kInvalidArgument when the clouds have no extent. Cost: measures their sampling once.
+double starting_scale_m(const PreparedScan& source, const PreparedScan& target, double min_scale_m);
+
 // Judges given poses (source -> target, files' frames) as register_clouds judges the hypotheses it finds, at
 // one scale: the symmetry guard (which adds their symmetric twins), the leading poses' full refinement and
 // the verdict, with the same figures and flags. For poses found elsewhere: a project's loops propose poses a
