@@ -13,18 +13,18 @@ void add_project_flags(CLI::App& command, ProjectFlags& flags, ProjectParams& pa
                          "best partners by a cheap overlap estimate of every pair), or a file of index pairs")
       ->capture_default_str();
   flags.partners = command.add_option("--partners", params.partners, "with screened pairs: partners registered per scan")
-                       ->check(CLI::PositiveNumber)
+                       ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}).description(""))
                        ->capture_default_str();
   command.add_flag("--json", flags.json, "print the result as JSON");
   command.add_option("--out-dir", flags.out_dir, "write NAME.pose.txt per registered scan and project.json here");
 }
 
 void apply_pairs(const ProjectFlags& flags, ProjectParams& params) {
-  bool named = false;
-  for (PairSelection selection :
-       {PairSelection::kAuto, PairSelection::kAll, PairSelection::kSequence, PairSelection::kScreened})
-    if (flags.pairs == to_string(selection)) params.pairs = selection, named = true;
-  if (!named) {
+  // "list" names no file: a file of that name is read as one.
+  const std::optional<PairSelection> named = pair_selection_named(flags.pairs);
+  if (named && named != PairSelection::kList) {
+    params.pairs = *named;
+  } else {
     params.pairs = PairSelection::kList;
     params.pair_list = read_pair_list(flags.pairs);
   }

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "http_json.h"
+#include "k4reg/project/candidate_pairs.h"
 #include "k4reg/util/error.h"
 
 namespace k4reg::service {
@@ -39,8 +40,7 @@ nlohmann::json json_value(const google::protobuf::FieldDescriptor& field, const 
   if (field.cpp_type() == FieldDescriptor::CPPTYPE_BOOL && (value == "true" || value == "false")) return value == "true";
   if (field.cpp_type() == FieldDescriptor::CPPTYPE_ENUM) {
     if (!value.empty() && value.find_first_not_of("0123456789") == std::string::npos) return std::stoi(value.substr(0, 9));
-    if (field.enum_type() == v1::PairSelection_descriptor() && (value == "all" || value == "sequence" || value == "list" ||
-                                                                value == "screened" || value == "auto")) {
+    if (field.enum_type() == v1::PairSelection_descriptor() && pair_selection_named(value)) {
       std::string upper = value;
       for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
       return "PAIR_SELECTION_" + upper;

@@ -127,6 +127,20 @@ TEST(ProjectRegistration, ScreenedPairsRegisterEachScanWithItsBestPartners) {
   EXPECT_THROW(register_project(bunny.scans, params), Error);
 }
 
+// The screen that leaves no pair out leaves no link unchecked for want of loops: two scans have one pair,
+// which no loop can check, and it is taken on its pairwise verdict as with all pairs.
+TEST(ProjectRegistration, ScreenedLinkInNoLoopIsAcceptedWhereTheScreenLeftNoPairOut) {
+  const BunnyProject bunny;
+  ProjectParams params = statue_params();
+  params.pairs = PairSelection::kScreened;
+  const ProjectResult r = register_project({bunny.scans[0], bunny.scans[1]}, params);
+  ASSERT_EQ(r.links.size(), 1u);
+  EXPECT_TRUE(r.links[0].accepted) << r.links[0].reason;
+  EXPECT_EQ(r.links[0].verdict, "unchecked");
+  EXPECT_TRUE(r.scans[1].registered) << r.scans[1].reason;
+  EXPECT_LT(rms_error_m(bunny.scans[1], r.scans[1].pose, bunny.truth[1]), 0.001);
+}
+
 TEST(ProjectRegistration, ScanOfAnotherObjectIsNotRegisteredAndTheRestStill) {
   BunnyProject bunny;
   // A mirrored bunny: shaped like the others, but no rigid motion puts it on them.

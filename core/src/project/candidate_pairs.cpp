@@ -55,6 +55,13 @@ const char* to_string(PairSelection selection) {
   return "?";
 }
 
+std::optional<PairSelection> pair_selection_named(std::string_view name) {
+  for (PairSelection selection : {PairSelection::kAll, PairSelection::kSequence, PairSelection::kList,
+                                  PairSelection::kScreened, PairSelection::kAuto})
+    if (name == to_string(selection)) return selection;
+  return std::nullopt;
+}
+
 std::vector<ScanPair> read_pair_list(const std::string& path) {
   std::ifstream in(path);
   if (!in) fail(ErrorCode::kNotFound, path + ": cannot open the pair list");

@@ -176,6 +176,19 @@ std::vector<std::size_t> unconfirmed_scans(std::size_t scans, const std::vector<
   return unconfirmed;
 }
 
+// Whether the screen left out a pair that could have closed a triangle with link (a, b): a pair of a or b
+// with a third scan. Where it left none out, a link in no loop owes that to the scene, as with all pairs.
+bool screen_left_out_a_partner(std::size_t scans, const std::vector<ScanPair>& pairs, std::size_t a, std::size_t b) {
+  std::vector<int> registered(scans, 0);  // pairs of a or b with each scan
+  for (const auto& [s, t] : pairs) {
+    if (s == a || s == b) ++registered[t];
+    if (t == a || t == b) ++registered[s];
+  }
+  for (std::size_t c = 0; c < scans; ++c)
+    if (c != a && c != b && registered[c] < 2) return true;
+  return false;
+}
+
 }  // namespace
 
 ProjectResult register_project(const std::vector<PointCloud>& scans, const ProjectParams& params,
@@ -337,9 +350,10 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     if (candidates[l].transforms.empty()) continue;  // failed, reason set
     link.verdict = to_string(s.verdict);
     link.candidate = s.candidate;
-    // With screened pairs a link in no loop may owe that to the screen, not to the scene: its scans' other
-    // partners were never registered. Nothing checked it, so it is not taken on its pairwise verdict alone.
-    const bool screened_out_of_loops = r.pairs_used == PairSelection::kScreened && s.verdict == LinkVerdict::kUnchecked;
+    // With screened pairs a link in no loop may owe that to the screen, not to the scene: where its scans' other
+    // partners were not all registered, nothing checked it, so it is not taken on its pairwise verdict alone.
+    const bool screened_out_of_loops = r.pairs_used == PairSelection::kScreened && s.verdict == LinkVerdict::kUnchecked &&
+                                       screen_left_out_a_partner(scans.size(), pairs, link.source, link.target);
     link.accepted = s.accepted() && !screened_out_of_loops;
     if (link.accepted) link.transform = candidates[l].transforms[s.candidate];
     switch (s.verdict) {

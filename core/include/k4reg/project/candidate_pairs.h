@@ -5,7 +5,9 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -28,6 +30,9 @@ PairSelection resolved(PairSelection selection, std::size_t scans);
 
 // "all", "sequence", "list", "screened", "auto".
 const char* to_string(PairSelection selection);
+
+// The selection with that name (to_string's), if any.
+std::optional<PairSelection> pair_selection_named(std::string_view name);
 
 using ScanPair = std::pair<std::size_t, std::size_t>;
 
