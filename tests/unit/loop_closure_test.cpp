@@ -27,7 +27,7 @@ struct Project {
   std::vector<LinkCandidates> all_pairs() const {
     std::vector<LinkCandidates> links;
     for (std::size_t s = 0; s < 4; ++s)
-      for (std::size_t t = s + 1; t < 4; ++t) links.push_back({s, t, {relative(s, t)}, 0.05, false});
+      for (std::size_t t = s + 1; t < 4; ++t) links.push_back({s, t, {relative(s, t)}, 0.05, false, 1.0, true, {}});
     return links;
   }
 };
@@ -84,9 +84,9 @@ TEST(LoopClosure, ErrorsWithinToleranceCloseTheLoop) {
 
 TEST(LoopClosure, WithoutLoopsThePairwiseVerdictDecides) {
   const Project p;
-  std::vector<LinkCandidates> chain{{0, 1, {p.relative(0, 1)}, 0.05, false},
-                                    {1, 2, {p.relative(1, 2)}, 0.05, true},
-                                    {2, 3, {}, 0.05, false}};
+  std::vector<LinkCandidates> chain{{0, 1, {p.relative(0, 1)}, 0.05, false, 1.0, true, {}},
+                                    {1, 2, {p.relative(1, 2)}, 0.05, true, 1.0, true, {}},
+                                    {2, 3, {}, 0.05, false, 1.0, true, {}}};
   const LoopSelectionResult r = select_loop_consistent(chain, p.radius);
   EXPECT_EQ(r.loops_checked, 0u);
   EXPECT_EQ(r.links[0].verdict, LinkVerdict::kUnchecked);
@@ -178,9 +178,9 @@ TEST(LoopClosure, OpenLoopsImplyTheirLinksPosesFromTheOtherTwo) {
 TEST(LoopClosure, LoopsClosedOnlyThroughARunnerUpImplyWhatTheWinnersGive) {
   const Project p;
   const Eigen::Matrix4d turned = kFlip * p.relative(0, 1);  // scan 1 half-turned in scan 0's frame
-  std::vector<LinkCandidates> links{{0, 1, {p.relative(0, 1), turned}, 0.05, false, 0.08, true},
-                                    {0, 2, {p.relative(0, 2)}, 0.05, false, 0.3, true},
-                                    {1, 2, {p.relative(0, 2) * rigid_inverse(turned)}, 0.05, false, 0.9, true}};
+  std::vector<LinkCandidates> links{{0, 1, {p.relative(0, 1), turned}, 0.05, false, 0.08, true, {}},
+                                    {0, 2, {p.relative(0, 2)}, 0.05, false, 0.3, true, {}},
+                                    {1, 2, {p.relative(0, 2) * rigid_inverse(turned)}, 0.05, false, 0.9, true, {}}};
   const LoopSelectionResult selection = select_loop_consistent(links, p.radius);
   ASSERT_EQ(selection.links[0].candidate, 1);  // the loop closes through the runner-up
   const std::vector<std::vector<Eigen::Matrix4d>> implied = poses_implied_by_open_loops(links, selection, p.radius);
