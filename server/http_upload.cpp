@@ -3,13 +3,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cctype>
 #include <map>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "http_json.h"
 #include "k4reg/project/candidate_pairs.h"
+#include "pair_selection.h"
 #include "k4reg/util/error.h"
 
 namespace k4reg::service {
@@ -40,11 +41,9 @@ nlohmann::json json_value(const google::protobuf::FieldDescriptor& field, const 
   if (field.cpp_type() == FieldDescriptor::CPPTYPE_BOOL && (value == "true" || value == "false")) return value == "true";
   if (field.cpp_type() == FieldDescriptor::CPPTYPE_ENUM) {
     if (!value.empty() && value.find_first_not_of("0123456789") == std::string::npos) return std::stoi(value.substr(0, 9));
-    if (field.enum_type() == v1::PairSelection_descriptor() && pair_selection_named(value)) {
-      std::string upper = value;
-      for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-      return "PAIR_SELECTION_" + upper;
-    }
+    if (field.enum_type() == v1::PairSelection_descriptor())
+      if (const std::optional<PairSelection> named = pair_selection_named(value))
+        return v1::PairSelection_Name(api::pair_selection_to_proto(*named));
   }
   return value;
 }
