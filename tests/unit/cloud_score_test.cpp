@@ -39,8 +39,9 @@ IcpPyramid::Stage patch(const Eigen::Vector3f& a, const Eigen::Vector3f& b,
 
 double score(const IcpPyramid::Stage& source) {
   const IcpPyramid::Stage target = corridor_end();
-  const FreeSpaceImage free_space(target.points, Eigen::Vector3f::Zero(), 3 * kSpacing_m);
-  const ScanViews views{&free_space, Eigen::Vector3f(0, 0, 0), Eigen::Vector3f::Zero()};
+  const Viewpoint scanner = Viewpoint::at(Eigen::Vector3f::Zero());
+  const FreeSpaceImage free_space(target.points, scanner, 3 * kSpacing_m);
+  const ScanViews views{&free_space, scanner, scanner};
   const float tau = 1.5f * kSpacing_m;
   return cloud_score(scored_source(source, 100000), target, *target.grid, tau, Eigen::Matrix4d::Identity(), &views, 1.0);
 }

@@ -1,5 +1,5 @@
 // The free-space image of a terrestrial scan: what the scanner saw to be empty, including open sky where it
-// looked and got no return at all, and what it cannot tell.
+// looked and got no return at all, and what it cannot tell; and of a range camera's view of an object.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -58,14 +58,14 @@ Eigen::Vector3f at(float range_m, float azimuth_deg, float elevation_deg) {
 }
 
 TEST(FreeSpace, SpaceInFrontOfTheFirstReturnIsEmptyAndBehindItOccluded) {
-  const FreeSpaceImage image(Plaza{}.scan(), Eigen::Vector3f::Zero(), 0.2);
+  const FreeSpaceImage image(Plaza{}.scan(), Viewpoint::at(Eigen::Vector3f::Zero()), 0.2);
   EXPECT_EQ(image.classify(at(10, 0, 10)), Seen::kEmpty);     // in front of the facade
   EXPECT_EQ(image.classify(Eigen::Vector3f(20, 0, 2)), Seen::kSurface);
   EXPECT_EQ(image.classify(at(40, 0, 5)), Seen::kOccluded);   // behind it
 }
 
 TEST(FreeSpace, OpenSkyWithinTheScannersReachContradictsAPointPlacedThere) {
-  const FreeSpaceImage image(Plaza{}.scan(), Eigen::Vector3f::Zero(), 0.2);
+  const FreeSpaceImage image(Plaza{}.scan(), Viewpoint::at(Eigen::Vector3f::Zero()), 0.2);
   // Behind the scanner, 15 degrees up: no return anywhere near, while the scanner reached 60 m elsewhere and
   // returned from as high up (the facade's top, 27 degrees up).
   EXPECT_EQ(image.classify(at(15, 180, 15)), Seen::kOpen);
@@ -79,7 +79,7 @@ TEST(FreeSpace, DirectionsTheScannerNeverLookedAtAreNoEvidence) {
   // A profiler-like field of view (as a Velodyne's -30 to +10 degrees): above it, no return says nothing.
   Plaza band;
   band.min_elevation_deg = -30, band.max_elevation_deg = 10;
-  const FreeSpaceImage image(band.scan(), Eigen::Vector3f::Zero(), 0.2);
+  const FreeSpaceImage image(band.scan(), Viewpoint::at(Eigen::Vector3f::Zero()), 0.2);
   EXPECT_EQ(image.classify(at(15, 180, 40)), Seen::kUnknown);
   EXPECT_EQ(image.classify(at(15, 0, 60)), Seen::kUnknown);
 }
@@ -89,9 +89,35 @@ TEST(FreeSpace, ASmallHoleInAWallIsNotOpenSky) {
   // behind the window is hidden, not contradicted.
   Plaza plaza;
   plaza.window_half_m = 1.0f;
-  const FreeSpaceImage image(plaza.scan(), Eigen::Vector3f::Zero(), 0.2);
+  const FreeSpaceImage image(plaza.scan(), Viewpoint::at(Eigen::Vector3f::Zero()), 0.2);
   const Eigen::Vector3f behind_window = 1.25f * Eigen::Vector3f(20, 0, 4);
   EXPECT_EQ(image.classify(behind_window), Seen::kUnknown);
+}
+
+// A range camera's view of two domes (radius 0.1 m, 0.3 m apart) from far above: a parallel image along +z.
+std::vector<Eigen::Vector3f> domes_seen_from_above() {
+  std::vector<Eigen::Vector3f> points;
+  for (const float centre_x : {0.0f, 0.3f})
+    for (float x = -0.1f; x <= 0.1f; x += 0.001f)
+      for (float y = -0.1f; y <= 0.1f; y += 0.001f)
+        if (x * x + y * y < 0.01f) points.emplace_back(centre_x + x, y, std::sqrt(0.01f - x * x - y * y));
+  return points;
+}
+
+TEST(FreeSpace, AnObjectViewSeenAlongItsCameraDirection) {
+  const Viewpoint camera = Viewpoint::along(Eigen::Vector3f::UnitZ());
+  const FreeSpaceImage image(domes_seen_from_above(), camera, 0.006, 0.002);
+  EXPECT_EQ(image.classify(Eigen::Vector3f(0, 0, 0.13f)), Seen::kEmpty);    // above a dome's top: seen through
+  EXPECT_EQ(image.classify(Eigen::Vector3f(0, 0, 0.1f)), Seen::kSurface);
+  EXPECT_EQ(image.classify(Eigen::Vector3f(0, 0, 0.0f)), Seen::kOccluded);  // under the dome
+  // Between the domes: the camera saw the background there, all around.
+  EXPECT_EQ(image.classify(Eigen::Vector3f(0.15f, 0, 0.05f)), Seen::kOpen);
+  // Beyond the image's edge: outside what the camera is known to have looked at.
+  EXPECT_EQ(image.classify(Eigen::Vector3f(1.0f, 0, 0.05f)), Seen::kUnknown);
+  // The camera's rays are parallel: every point is seen along -z.
+  EXPECT_TRUE(camera.ray_to(Eigen::Vector3f(5, 6, 7)).isApprox(-Eigen::Vector3f::UnitZ()));
+  const Eigen::Affine3f turned(Eigen::AngleAxisf(static_cast<float>(M_PI) / 2, Eigen::Vector3f::UnitX()));
+  EXPECT_TRUE(camera.moved(turned).toward_scanner.isApprox(-Eigen::Vector3f::UnitY(), 1e-6f));
 }
 
 }  // namespace

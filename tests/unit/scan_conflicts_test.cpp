@@ -1,5 +1,5 @@
-// A confident pairwise result that the project contradicts refuses both of its scans (never the reference);
-// doubtful, accepted or agreeing links refuse nothing.
+// A confident pairwise result that the project contradicts refuses its scans (never the reference) unless their
+// accepted links outnumber such results; doubtful, accepted or agreeing links refuse nothing.
 #include <gtest/gtest.h>
 
 #include "k4reg/geometry/rigid_motion.h"
@@ -45,6 +45,21 @@ TEST(ScanConflicts, ConfidentRejectedLinkThatDisagreesRefusesBothScansButTheRefe
   EXPECT_TRUE(r.scans[1].registered);
   EXPECT_FALSE(r.scans[2].registered);
   EXPECT_NE(r.scans[2].reason.find("link 2 (0 -> 2)"), std::string::npos) << r.scans[2].reason;
+}
+
+// Scan 2 held by two accepted links (1 -> 2 and a fourth scan's 2 -> 3) against the one confident link that
+// contradicts it: the one link is outvoted, and no scan leaves.
+TEST(ScanConflicts, AScanItsAcceptedLinksHoldMoreFirmlyThanTheContradictingOnesStays) {
+  ProjectResult r = placed_project();
+  r.scans.push_back(r.scans[2]);
+  r.scans[3].pose = shifted(6.0);
+  ProjectLink extra = r.links[1];
+  extra.source = 2, extra.target = 3;
+  extra.transform = rigid_inverse(r.scans[3].pose) * r.scans[2].pose;
+  r.links.push_back(extra);
+  r.links[2].transform = shifted(1.0) * r.links[2].transform;  // 1 m off, confident
+  refuse_conflicted_scans(r, std::vector<double>(4, 10.0));
+  for (const ProjectScan& s : r.scans) EXPECT_TRUE(s.registered) << s.reason;
 }
 
 TEST(ScanConflicts, DoubtfulOrAcceptedOrSmallMisfitsRefuseNothing) {

@@ -3,7 +3,9 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "k4reg/geometry/rigid_motion.h"
 #include "k4reg/util/error.h"
@@ -134,6 +136,24 @@ PoseGraphResult optimize_pose_graph(const std::vector<Eigen::Matrix4d>& initial,
     out.residual_m.push_back(displacement_m(link_misfit(out.poses[link.from], out.poses[link.to], link.measured),
                                             link.lever_arm_m));
   return out;
+}
+
+PoseGraphResult optimize_pose_graph_robustly(const std::vector<Eigen::Matrix4d>& initial,
+                                             const std::vector<PoseGraphLink>& links, const PoseGraphParams& params) {
+  constexpr int kMaxTightenings = 4;
+  PoseGraphResult solved = optimize_pose_graph(initial, links, params);
+  if (links.size() < 3) return solved;
+  PoseGraphParams tighter = params;
+  for (int round = 0; round < kMaxTightenings; ++round) {
+    std::vector<double> residuals = solved.residual_m;
+    std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
+    const double scale_m = 2.0 * residuals[residuals.size() / 2];
+    // Only while the scale shrinks clearly: once it settles, the links agree as well as they can.
+    if (!(scale_m > 0.0 && (tighter.huber_m <= 0.0 || scale_m < 0.9 * tighter.huber_m))) break;
+    tighter.huber_m = scale_m;
+    solved = optimize_pose_graph(solved.poses, links, tighter);
+  }
+  return solved;
 }
 
 }  // namespace k4reg

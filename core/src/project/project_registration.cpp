@@ -414,6 +414,18 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
       graph.push_back({link.source, link.target, link.transform, radius[link.source], 1.0});
       tolerances.push_back(link_tolerance_m(link));
     }
+    // Each link weighs by its precision: its refinement's residual, against the median link's. A pose its loops
+    // implied fits its pair less closely than a pair's own winner (1.2 mm against 0.4-0.7 mm on the bunny).
+    if (!graph.empty()) {
+      std::vector<double> rmse;
+      for (std::size_t l : used) rmse.push_back(r.links[l].rmse_m);
+      std::nth_element(rmse.begin(), rmse.begin() + rmse.size() / 2, rmse.end());
+      const double typical_m = rmse[rmse.size() / 2];
+      for (std::size_t e = 0; e < graph.size(); ++e) {
+        const double own_m = r.links[used[e]].rmse_m;
+        if (typical_m > 0.0 && own_m > typical_m) graph[e].weight = (typical_m / own_m) * (typical_m / own_m);
+      }
+    }
     // Scans that a confident pairwise result contradicts leave the project (scan_conflicts.h).
     refuse_conflicted_scans(r, radius);
     refuse_minority_placements(r);
@@ -447,7 +459,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
       std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
       solver.huber_m = sorted[sorted.size() / 2];
     }
-    const PoseGraphResult refined = optimize_pose_graph(poses, graph, solver);
+    const PoseGraphResult refined = optimize_pose_graph_robustly(poses, graph, solver);
     // The link the refined project contradicts most, beyond its tolerance, goes; then all again.
     std::size_t worst = used.size();
     double worst_excess = 1.0;

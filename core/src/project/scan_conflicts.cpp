@@ -9,7 +9,10 @@
 namespace k4reg {
 
 void refuse_conflicted_scans(ProjectResult& r, const std::vector<double>& scan_radius_m) {
+  std::vector<std::size_t> holding(r.scans.size(), 0), contradicting(r.scans.size(), 0);
   std::vector<std::string> reasons(r.scans.size());
+  for (const ProjectLink& link : r.links)
+    if (link.accepted) ++holding[link.source], ++holding[link.target];
   for (std::size_t l = 0; l < r.links.size(); ++l) {
     const ProjectLink& link = r.links[l];
     if (link.accepted || link.verdict == "failed" || link.ambiguous || !link.well_supported) continue;
@@ -17,16 +20,19 @@ void refuse_conflicted_scans(ProjectResult& r, const std::vector<double>& scan_r
     const double misfit = displacement_m(link_misfit(r.scans[link.source].pose, r.scans[link.target].pose, link.transform),
                                          scan_radius_m.at(link.source));
     if (misfit <= kLoopToleranceFactor * link_tolerance_m(link)) continue;
-    for (std::size_t scan : {link.source, link.target})
-      if (scan != r.reference && reasons[scan].empty())
+    for (std::size_t scan : {link.source, link.target}) {
+      ++contradicting[scan];
+      if (reasons[scan].empty())
         reasons[scan] = fmt::format(
             "in conflict: link {} ({} -> {}), a confident pairwise result, puts it {:.3g} m from where the other links do",
             l, link.source, link.target, misfit);
+    }
   }
   for (std::size_t i = 0; i < r.scans.size(); ++i)
-    if (!reasons[i].empty()) {
+    if (i != r.reference && contradicting[i] > 0 && contradicting[i] >= holding[i]) {
       r.scans[i].registered = false;
-      r.scans[i].reason = reasons[i];
+      r.scans[i].reason = reasons[i] + fmt::format(" ({} such links against the {} accepted ones that place it)",
+                                                   contradicting[i], holding[i]);
     }
 }
 

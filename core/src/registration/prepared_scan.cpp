@@ -1,6 +1,8 @@
 #include "k4reg/registration/prepared_scan.h"
 
 #include "k4reg/registration/pose_score.h"
+#include "k4reg/registration/single_view.h"
+#include "k4reg/util/error.h"
 
 #include <map>
 #include <mutex>
@@ -50,6 +52,8 @@ struct PreparedScan::Cache {
   Entries<std::tuple<double, int, double>, Pyramid> pyramids;  // sigma, stages, distance factor
   Entries<std::tuple<double, int, bool, int, int, double>, ScanKeypoints> keypoints;  // sigma, signal, DoG
   Entries<double, FreeSpaceImage> free_space;
+  Entries<double, std::optional<Eigen::Vector3f>> view_direction;       // sigma
+  Entries<std::pair<double, double>, FreeSpaceImage> view_free_space;  // sigma, margin
   Entries<double, double> self_agreement;
 };
 
@@ -91,8 +95,28 @@ const ScanKeypoints& PreparedScan::keypoints(double sigma_m, KeypointSignal sign
 }
 
 const FreeSpaceImage& PreparedScan::free_space(double margin_m) const {
-  return cache_->free_space.get(margin_m,
-                                [&] { return FreeSpaceImage(cloud_->points, scanner_position(*cloud_), margin_m); });
+  return cache_->free_space.get(
+      margin_m, [&] { return FreeSpaceImage(cloud_->points, Viewpoint::at(scanner_position(*cloud_)), margin_m); });
+}
+
+const std::optional<Eigen::Vector3f>& PreparedScan::view_direction(double sigma_m, const CancellationToken* cancel) const {
+  return cache_->view_direction.get(sigma_m, [&] {
+    // The normals of a voxel in a few thousand are plenty for one direction and a share.
+    constexpr std::size_t kJudgedPoints = 20000;
+    const std::vector<Eigen::Vector3f>& points = voxels(sigma_m, cancel).cloud.points;
+    const std::vector<Eigen::Vector3f> judged = every_kth(points, kJudgedPoints);
+    const double radius_m = 2.0 * sigma_m;
+    return single_view_direction(judged, estimate_normals(judged, points, NeighborGrid(points, radius_m), radius_m));
+  });
+}
+
+const FreeSpaceImage& PreparedScan::view_free_space(double sigma_m, double margin_m, const CancellationToken* cancel) const {
+  return cache_->view_free_space.get({sigma_m, margin_m}, [&] {
+    const std::optional<Eigen::Vector3f>& toward = view_direction(sigma_m, cancel);
+    if (!toward) fail(ErrorCode::kInternal, "view_free_space: the scan is not a single view");
+    const double cell_m = std::max(sigma_m, 2.0 * sampling().spacing_m);
+    return FreeSpaceImage(cloud_->points, Viewpoint::along(*toward), margin_m, cell_m);
+  });
 }
 
 double PreparedScan::surface_self_agreement(double sigma_m, const CancellationToken* cancel) const {

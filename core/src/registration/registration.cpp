@@ -358,10 +358,22 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   const double delta = !plain ? 2.0 * sigma : timer.run("plain_grid", [&] {
     return params.plain_voxel_m > 0 ? params.plain_voxel_m : spacing_for_count(source_voxels.cloud, 4 * sigma, 2000);
   });
-  result.free_space_used = use_free_space(params.free_space, source_voxels, target_voxels);
-  // Raw points fill every cell.
-  const FreeSpaceImage* free_space = result.free_space_used ? &target_scan.free_space(3.0 * delta) : nullptr;
-  const ScanViews views{free_space, scanner_position(source), scanner_position(target)};
+  // Free space (free_space.h): the scanners' where both scans say where theirs stood, else the cameras' where
+  // both are single views of an object. Raw points fill every cell.
+  const double margin_m = 3.0 * delta;
+  ScanViews views;
+  if (use_free_space(params.free_space, source_voxels, target_voxels)) {
+    views = {&target_scan.free_space(margin_m), Viewpoint::at(scanner_position(source)),
+             Viewpoint::at(scanner_position(target))};
+  } else if (params.free_space == FreeSpaceCheck::kAuto) {
+    const std::optional<Eigen::Vector3f>& source_camera = source_scan.view_direction(sigma, cancel);
+    const std::optional<Eigen::Vector3f>& target_camera = target_scan.view_direction(sigma, cancel);
+    if (source_camera && target_camera)
+      views = {&target_scan.view_free_space(sigma, margin_m, cancel), Viewpoint::along(*source_camera),
+               Viewpoint::along(*target_camera)};
+  }
+  result.free_space_used = views.target_free_space != nullptr;
+  const FreeSpaceImage* free_space = views.target_free_space;
 
   // 2. The point sets 4PCS runs on: DoG keypoints (K-4PCS) or a coarser voxel grid (plain 4PCS).
   std::deque<PointSets> point_sets;  // one per signal asked for so far (a deque: CoarseAlignment points into it)

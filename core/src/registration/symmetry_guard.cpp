@@ -105,7 +105,7 @@ double cloud_score(const ScoredSource& scored, const IcpPyramid::Stage& referenc
   constexpr float kFacingCos = 0.5f;
   const std::vector<Eigen::Vector3f>& source = scored.points;
   const Eigen::Affine3f a = to_affine3f(t);
-  const Eigen::Vector3f source_scanner = views ? Eigen::Vector3f(a * views->source_scanner_m) : Eigen::Vector3f::Zero();
+  const Viewpoint source_view = views ? views->source.moved(a) : Viewpoint{};
   struct Counts {
     std::size_t consistent = 0, contradicted = 0, unseen = 0;
   };
@@ -117,8 +117,8 @@ double cloud_score(const ScoredSource& scored, const IcpPyramid::Stage& referenc
           const Eigen::Vector3f q = a * source[i];
           const int k = grid.nearest_within(q, tau);
           if (k >= 0) {
-            const bool same_side = !views || seen_from_the_same_side(reference.normals[k], q - source_scanner,
-                                                                      reference.points[k] - views->target_scanner_m);
+            const bool same_side = !views || seen_from_the_same_side(reference.normals[k], source_view.ray_to(q),
+                                                                      views->target.ray_to(reference.points[k]));
             ++(same_side ? c.consistent : c.unseen);
             continue;
           }
@@ -128,7 +128,7 @@ double cloud_score(const ScoredSource& scored, const IcpPyramid::Stage& referenc
             case FreeSpaceImage::Seen::kSurface: ++c.consistent; break;
             case FreeSpaceImage::Seen::kEmpty:
             case FreeSpaceImage::Seen::kOpen: {
-              const Eigen::Vector3f ray = q - views->target_scanner_m;
+              const Eigen::Vector3f ray = views->target.ray_to(q);
               const float cos_needed = seen == FreeSpaceImage::Seen::kOpen ? kFacingCos : kVisibleCos;
               const bool visible = std::abs((a.linear() * scored.normals[i]).dot(ray)) >= cos_needed * ray.norm();
               ++(visible ? c.contradicted : c.unseen);

@@ -1,9 +1,10 @@
-// Scans whose placement a confident pairwise result contradicts. A link whose pairwise verdict was
-// unambiguous and well supported, that the loops did not accept, and that puts its two placed scans further
-// apart than its tolerance (kLoopToleranceFactor x link_tolerance_m) leaves both in doubt: the evidence is in
-// conflict, and nothing says which side is right. A front/back-symmetric object seen from the back can
-// outvote the truth with such links, consistent among themselves; refusing both scans of every contradicted
-// confident link keeps them from being registered confidently wrong.
+// Scans whose placement confident pairwise results contradict. A link whose pairwise verdict was unambiguous
+// and well supported, that the loops did not accept, and that puts its two placed scans further apart than its
+// tolerance (kLoopToleranceFactor x link_tolerance_m) speaks against both placements: the evidence is in
+// conflict. A front/back-symmetric object seen from the back can outvote the truth with such links, consistent
+// among themselves; a scan is therefore refused where such links are at least as many as the accepted links that
+// place it. Where its accepted links outnumber them (an object's view held by five neighbours, contradicted by
+// one flipped pair whose symmetric details neither view saw), the one link is outvoted and the scan stays.
 // Cost: O(links).
 #pragma once
 

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,12 @@ class PreparedScan {
                                  const CancellationToken* cancel) const;
   // The raw points seen from the scanner (the file frame's origin), with this margin.
   const FreeSpaceImage& free_space(double margin_m) const;
+  // Where the scan is one range camera's view of an object (single_view.h, judged on normals at sigma_m's
+  // voxels): the direction toward the camera; else nothing.
+  const std::optional<Eigen::Vector3f>& view_direction(double sigma_m, const CancellationToken* cancel) const;
+  // The raw points seen along view_direction(sigma_m) (which must be known), in a parallel image with cells of
+  // sigma_m or twice the sampling spacing, whichever is larger, and this margin.
+  const FreeSpaceImage& view_free_space(double sigma_m, double margin_m, const CancellationToken* cancel) const;
   // What a perfect registration onto this scan reaches in surface_agreement (pose_score.h) at sigma_m: the
   // voxel centroids of every other point against the surface of the rest, two samplings of one surface with
   // independent noise. Clean scans give 0.9 or more; noise and clutter at the scale of sigma_m give less.

@@ -26,8 +26,9 @@ enum class KeypointSignal {
 };
 
 enum class FreeSpaceCheck {
-  kAuto,  // on when both scans look like terrestrial scans taken from (and around) their frame's origin
-  kOn,
+  kAuto,  // on when both scans look like terrestrial scans taken from (and around) their frame's origin, or
+          // like single views of an object by a range camera (single_view.h: seen along their viewing direction)
+  kOn,    // from the frames' origins
   kOff,
 };
 

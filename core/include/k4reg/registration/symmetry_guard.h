@@ -35,12 +35,13 @@ struct SymmetryGuardResult {
   double ambiguity_margin = 1.0;       // (best - runner-up) / best; 1 when there is no runner-up
 };
 
-// What is known of the two scans' viewpoints (terrestrial scans; null for object scans): the target
-// scanner's free space and both scanner positions, each in its own scan's local frame.
+// What is known of the two scans' viewpoints (free_space.h: terrestrial scanners' positions, or object views'
+// directions; null where the scans do not say): the target's free space and both viewpoints, each in its own
+// scan's local frame.
 struct ScanViews {
   const FreeSpaceImage* target_free_space = nullptr;
-  Eigen::Vector3f source_scanner_m = Eigen::Vector3f::Zero();
-  Eigen::Vector3f target_scanner_m = Eigen::Vector3f::Zero();
+  Viewpoint source;  // in the source's frame
+  Viewpoint target;
 };
 
 // Source points to score (local frame) and their normals (zero where too few neighbours): free space can
