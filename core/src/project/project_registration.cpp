@@ -115,6 +115,12 @@ double link_tolerance_m(const ProjectLink& link) { return std::max(2.0 * link.mi
 
 namespace {
 
+// The middle value (the upper of the two middle ones for an even count); values must not be empty.
+double median(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
 // A pair's link as registered (before selection) and its candidates for the loops: the pairwise winner first.
 LinkCandidates link_from_outcome(const PairOutcome& outcome, const ScanPair& pair, ProjectLink& link) {
   const auto [s, t] = pair;
@@ -419,8 +425,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     if (!graph.empty()) {
       std::vector<double> rmse;
       for (std::size_t l : used) rmse.push_back(r.links[l].rmse_m);
-      std::nth_element(rmse.begin(), rmse.begin() + rmse.size() / 2, rmse.end());
-      const double typical_m = rmse[rmse.size() / 2];
+      const double typical_m = median(std::move(rmse));
       for (std::size_t e = 0; e < graph.size(); ++e) {
         const double own_m = r.links[used[e]].rmse_m;
         if (typical_m > 0.0 && own_m > typical_m) graph[e].weight = (typical_m / own_m) * (typical_m / own_m);
@@ -454,11 +459,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     PoseGraphParams solver;
     solver.fixed = r.reference;
     solver.levelled = params.pairwise.levelled;
-    if (!tolerances.empty()) {
-      std::vector<double> sorted = tolerances;
-      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-      solver.huber_m = sorted[sorted.size() / 2];
-    }
+    if (!tolerances.empty()) solver.huber_m = median(tolerances);
     const PoseGraphResult refined = optimize_pose_graph_robustly(poses, graph, solver);
     // The link the refined project contradicts most, beyond its tolerance, goes; then all again.
     std::size_t worst = used.size();

@@ -101,7 +101,7 @@ const FreeSpaceImage& PreparedScan::free_space(double margin_m) const {
 
 const std::optional<Eigen::Vector3f>& PreparedScan::view_direction(double sigma_m, const CancellationToken* cancel) const {
   return cache_->view_direction.get(sigma_m, [&] {
-    // The normals of a voxel in a few thousand are plenty for one direction and a share.
+    // The normals of at most 20 000 voxels are plenty for one direction and a share.
     constexpr std::size_t kJudgedPoints = 20000;
     const std::vector<Eigen::Vector3f>& points = voxels(sigma_m, cancel).cloud.points;
     const std::vector<Eigen::Vector3f> judged = every_kth(points, kJudgedPoints);

@@ -373,7 +373,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
                Viewpoint::along(*target_camera)};
   }
   result.free_space_used = views.target_free_space != nullptr;
-  const FreeSpaceImage* free_space = views.target_free_space;
+  const ScanViews* seen = result.free_space_used ? &views : nullptr;  // what the guard and the scorer weigh
 
   // 2. The point sets 4PCS runs on: DoG keypoints (K-4PCS) or a coarser voxel grid (plain 4PCS).
   std::deque<PointSets> point_sets;  // one per signal asked for so far (a deque: CoarseAlignment points into it)
@@ -432,7 +432,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
     //    voxelised clouds, where the furniture that breaks a room's symmetry is visible.
     const auto& icp = icp_pyramids();
     out.guarded = timer.run("symmetry_guard", [&] {
-      return rank_hypotheses(icp.first, icp.second, matched.hypotheses, overlap, free_space ? &views : nullptr,
+      return rank_hypotheses(icp.first, icp.second, matched.hypotheses, overlap, seen,
                              params.levelled, cancel);
     });
     return out;
@@ -460,7 +460,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
       hypotheses[i].transform = to_local_frames(given_poses[i], source.origin_m, target.origin_m);
     const auto& icp = icp_pyramids();
     judged.guarded = timer.run("symmetry_guard", [&] {
-      return rank_hypotheses(icp.first, icp.second, std::move(hypotheses), judged.overlap, free_space ? &views : nullptr,
+      return rank_hypotheses(icp.first, icp.second, std::move(hypotheses), judged.overlap, seen,
                              params.levelled, cancel);
     });
     rounds_run = 1;
@@ -497,7 +497,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   const auto& icp = icp_pyramids();
   IcpParams final_params = icp_params;
   if (!params.icp) final_params.max_iterations = 0;  // quality figures only, at the finest stage
-  const PoseScorer scorer(icp.first, icp.second, free_space ? &views : nullptr, result.overlap_used);
+  const PoseScorer scorer(icp.first, icp.second, seen, result.overlap_used);
   const SurfaceBar bar(target_scan, sigma, cancel);
   auto judge = [&](const SymmetryGuardResult& guarded) {
     return judge_contenders(guarded, icp.first, icp.second, final_params, scorer, bar, params.icp, sigma, timer, cancel);
@@ -509,7 +509,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   if (params.icp && verdict.margin < kAmbiguousMargin &&
       repeats_under_a_shift(verdict.hypotheses, 2.0 * icp.second.stages.front().voxel_m)) {
     const SymmetryGuardResult wider = timer.run("symmetry_guard", [&] {
-      return rank_hypotheses(icp.first, icp.second, verdict.hypotheses, result.overlap_used, free_space ? &views : nullptr,
+      return rank_hypotheses(icp.first, icp.second, verdict.hypotheses, result.overlap_used, seen,
                              params.levelled, cancel, true);
     });
     verdict = judge(wider);
