@@ -48,6 +48,14 @@ RegistrationFlags add_registration_flags(CLI::App& command, RegistrationParams& 
                                                       {"geometric", KeypointSignal::kGeometric}};
   flags.signal = command.add_option("--signal", params.signal, "keypoint signal: auto, intensity or geometric")
                      ->transform(CLI::CheckedTransformer(signals, CLI::ignore_case));
+  const std::map<std::string, FreeSpaceCheck> free_space{
+      {"auto", FreeSpaceCheck::kAuto}, {"on", FreeSpaceCheck::kOn}, {"off", FreeSpaceCheck::kOff}};
+  flags.free_space =
+      command
+          .add_option("--free-space", params.free_space,
+                      "judge poses by the scanners' free space: auto (terrestrial scans from their frame origin, or "
+                      "single object views), on (scanners at the frames' origins) or off")
+          ->transform(CLI::CheckedTransformer(free_space, CLI::ignore_case));
   const std::map<std::string, CoarseMethod> methods{{"k4pcs", CoarseMethod::kKeypoint4pcs},
                                                     {"4pcs", CoarseMethod::kPlain4pcs}};
   flags.method =

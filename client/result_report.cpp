@@ -36,6 +36,8 @@ nlohmann::json result_to_json(const RegistrationResult& r) {
   j["ambiguity_margin"] = r.ambiguity_margin;
   j["ambiguous"] = r.ambiguous;
   j["ambiguity_reason"] = r.ambiguity_reason;
+  j["well_supported"] = r.well_supported;
+  j["free_space_used"] = r.free_space_used;
   j["min_scale_m_used"] = r.min_scale_m_used;
   j["overlap_used"] = r.overlap_used;
   j["axis_constraint"] = axis_constraint(r.constraint);
@@ -87,6 +89,8 @@ void print_result_table(std::ostream& out, const RegistrationResult& r) {
   out << fmt::format("{:<22}{:.2f}\n", "overlap used", r.overlap_used);
   out << fmt::format("{:<22}{:.3f}\n", "ambiguity margin", r.ambiguity_margin);
   out << fmt::format("{:<22}{}\n", "ambiguous", r.ambiguous ? "yes: " + r.ambiguity_reason : "no");
+  out << fmt::format("{:<22}{}\n", "well supported", r.well_supported ? "yes" : "no");
+  out << fmt::format("{:<22}{}\n", "free space used", r.free_space_used ? "yes" : "no (geometry alone)");
   out << fmt::format("{:<22}{}\n", "hypotheses", r.hypotheses.size());
   for (std::size_t k = 0; k < r.hypotheses.size(); ++k) {
     const Hypothesis& h = r.hypotheses[k];

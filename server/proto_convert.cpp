@@ -145,6 +145,7 @@ void result_to_proto(const RegistrationResult& r, v1::RegistrationResult* m) {
   m->set_ambiguous(r.ambiguous);
   m->set_ambiguity_reason(r.ambiguity_reason);
   m->set_well_supported(r.well_supported);
+  m->set_free_space_used(r.free_space_used);
   m->set_min_scale_m_used(r.min_scale_m_used);
   m->set_overlap_used(r.overlap_used);
   m->clear_hypotheses();

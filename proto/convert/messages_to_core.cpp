@@ -78,6 +78,7 @@ RegistrationResult result_from_proto(const v1::RegistrationResult& m) {
   r.ambiguous = m.ambiguous();
   r.ambiguity_reason = m.ambiguity_reason();
   r.well_supported = m.well_supported();
+  r.free_space_used = m.free_space_used();
   r.min_scale_m_used = m.min_scale_m_used();
   r.overlap_used = m.overlap_used();
   for (const v1::Hypothesis& h : m.hypotheses())

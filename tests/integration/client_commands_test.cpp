@@ -93,6 +93,8 @@ TEST_F(ClientCommands, RegisterByUploadGivesAlignsTransformAndJsonLayout) {
   const nlohmann::json remote = nlohmann::json::parse(run.out);
   EXPECT_EQ(remote["transform"], (*local_)["transform"]);  // bit-identical: JSON keeps every digit
   for (const auto& [key, value] : local_->items()) EXPECT_TRUE(remote.contains(key)) << key;
+  for (const char* key : {"ambiguous", "well_supported", "free_space_used", "min_scale_m_used", "overlap_used"})
+    EXPECT_EQ(remote[key], (*local_)[key]) << key;
   EXPECT_EQ(remote["request_id"], "client-test-42");
   EXPECT_EQ(remote["server"]["server_id"], "client-test");
   EXPECT_GT(remote["server_timings"]["upload_s"].get<double>(), 0.0);

@@ -1,12 +1,15 @@
-// Parts of the k4reg command line that need no server: latency statistics and --server parsing.
+// Parts of the k4reg command line that need no server: latency statistics, --server parsing and the mapping of
+// registration flags to the request.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <numeric>
 #include <stdexcept>
 
 #include "channel.h"
 #include "latency_stats.h"
 #include "progress_bar.h"
+#include "proto_mapping.h"
 
 namespace k4reg::cli {
 namespace {
@@ -93,6 +96,30 @@ TEST(HumanBytes, DecimalUnits) {
   EXPECT_EQ(human_bytes(999), "999 B");
   EXPECT_EQ(human_bytes(964'600), "964.6 kB");
   EXPECT_EQ(human_bytes(2.5e9), "2.5 GB");
+}
+
+// A remote request carries exactly the flags the user gave, so the server's defaults apply to the rest.
+TEST(RegistrationFlagsToProto, OnlyTheGivenFlagsAreSent) {
+  const auto parse = [](std::vector<std::string> args) {
+    CLI::App app;
+    RegistrationParams params;
+    const RegistrationFlags flags = add_registration_flags(app, params);
+    std::reverse(args.begin(), args.end());  // CLI11 parses a vector given last argument first
+    app.parse(args);
+    return params_to_proto(params, flags);
+  };
+  const v1::RegistrationParams none = parse({});
+  EXPECT_FALSE(none.has_min_scale_m());
+  EXPECT_EQ(none.free_space(), v1::FREE_SPACE_CHECK_UNSPECIFIED);
+  EXPECT_EQ(none.signal(), v1::KEYPOINT_SIGNAL_UNSPECIFIED);
+
+  EXPECT_EQ(parse({"--free-space", "off"}).free_space(), v1::FREE_SPACE_CHECK_OFF);
+  EXPECT_EQ(parse({"--free-space", "ON"}).free_space(), v1::FREE_SPACE_CHECK_ON);
+  const v1::RegistrationParams given = parse({"--free-space", "auto", "--min-scale", "0.05", "--signal", "geometric"});
+  EXPECT_EQ(given.free_space(), v1::FREE_SPACE_CHECK_AUTO);
+  EXPECT_DOUBLE_EQ(given.min_scale_m(), 0.05);
+  EXPECT_EQ(given.signal(), v1::KEYPOINT_SIGNAL_GEOMETRIC);
+  EXPECT_THROW(parse({"--free-space", "sometimes"}), CLI::ValidationError);
 }
 
 }  // namespace
