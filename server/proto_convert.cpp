@@ -7,39 +7,12 @@
 #include <memory>
 #include <string>
 
+#include "enum_convert.h"
 #include "k4reg/util/error.h"
 #include "messages_to_core.h"
 
 namespace k4reg::service {
 namespace {
-
-KeypointSignal signal_from_proto(v1::KeypointSignal signal) {
-  switch (signal) {
-    case v1::KEYPOINT_SIGNAL_UNSPECIFIED:
-      return RegistrationParams{}.signal;
-    case v1::KEYPOINT_SIGNAL_AUTO:
-      return KeypointSignal::kAuto;
-    case v1::KEYPOINT_SIGNAL_INTENSITY:
-      return KeypointSignal::kIntensity;
-    case v1::KEYPOINT_SIGNAL_GEOMETRIC:
-      return KeypointSignal::kGeometric;
-    default:
-      fail(ErrorCode::kInvalidArgument, "params.signal: unknown value " + std::to_string(signal));
-  }
-}
-
-CoarseMethod method_from_proto(v1::CoarseMethod method) {
-  switch (method) {
-    case v1::COARSE_METHOD_UNSPECIFIED:
-      return RegistrationParams{}.method;
-    case v1::COARSE_METHOD_KEYPOINT_4PCS:
-      return CoarseMethod::kKeypoint4pcs;
-    case v1::COARSE_METHOD_PLAIN_4PCS:
-      return CoarseMethod::kPlain4pcs;
-    default:
-      fail(ErrorCode::kInvalidArgument, "params.method: unknown value " + std::to_string(method));
-  }
-}
 
 // The core owns the valid ranges; checking them here refuses bad parameters before a job is queued or
 // an upload accepted.
@@ -53,21 +26,6 @@ void check_ranges(const RegistrationParams& params) {
 
 }  // namespace
 
-FreeSpaceCheck free_space_from_proto(v1::FreeSpaceCheck check) {
-  switch (check) {
-    case v1::FREE_SPACE_CHECK_UNSPECIFIED:
-      return RegistrationParams{}.free_space;
-    case v1::FREE_SPACE_CHECK_AUTO:
-      return FreeSpaceCheck::kAuto;
-    case v1::FREE_SPACE_CHECK_ON:
-      return FreeSpaceCheck::kOn;
-    case v1::FREE_SPACE_CHECK_OFF:
-      return FreeSpaceCheck::kOff;
-    default:
-      fail(ErrorCode::kInvalidArgument, "params.free_space: unknown value " + std::to_string(check));
-  }
-}
-
 RegistrationParams params_from_proto(const v1::RegistrationParams& m) {
   RegistrationParams p;
   if (m.has_min_scale_m()) p.min_scale_m = m.min_scale_m();
@@ -75,8 +33,8 @@ RegistrationParams params_from_proto(const v1::RegistrationParams& m) {
   if (m.has_octaves()) p.octaves = m.octaves();
   if (m.has_scales_per_octave()) p.scales_per_octave = m.scales_per_octave();
   if (m.has_min_contrast()) p.min_contrast = m.min_contrast();
-  p.signal = signal_from_proto(m.signal());
-  p.method = method_from_proto(m.method());
+  p.signal = api::from_proto(m.signal());
+  p.method = api::from_proto(m.method());
   if (m.has_plain_voxel_m()) p.plain_voxel_m = m.plain_voxel_m();
   if (m.has_max_bases()) p.max_bases = m.max_bases();
   if (m.has_hypotheses_kept()) p.hypotheses_kept = m.hypotheses_kept();
@@ -86,7 +44,7 @@ RegistrationParams params_from_proto(const v1::RegistrationParams& m) {
   if (m.has_seed()) p.seed = m.seed();
   if (m.has_threads()) p.threads = m.threads();
   if (m.has_time_budget_s()) p.time_budget_s = m.time_budget_s();
-  p.free_space = free_space_from_proto(m.free_space());
+  p.free_space = api::from_proto(m.free_space());
   check_ranges(p);
   return p;
 }
@@ -178,11 +136,8 @@ void params_to_proto(const RegistrationParams& p, v1::RegistrationParams* m) {
   m->set_octaves(p.octaves);
   m->set_scales_per_octave(p.scales_per_octave);
   m->set_min_contrast(p.min_contrast);
-  const v1::KeypointSignal signals[] = {v1::KEYPOINT_SIGNAL_AUTO, v1::KEYPOINT_SIGNAL_INTENSITY,
-                                        v1::KEYPOINT_SIGNAL_GEOMETRIC};
-  m->set_signal(signals[static_cast<int>(p.signal)]);
-  const v1::CoarseMethod methods[] = {v1::COARSE_METHOD_KEYPOINT_4PCS, v1::COARSE_METHOD_PLAIN_4PCS};
-  m->set_method(methods[static_cast<int>(p.method)]);
+  m->set_signal(api::to_proto(p.signal));
+  m->set_method(api::to_proto(p.method));
   m->set_plain_voxel_m(p.plain_voxel_m);
   m->set_max_bases(p.max_bases);
   m->set_hypotheses_kept(p.hypotheses_kept);
@@ -192,8 +147,7 @@ void params_to_proto(const RegistrationParams& p, v1::RegistrationParams* m) {
   m->set_seed(p.seed);
   m->set_threads(p.threads);
   m->set_time_budget_s(p.time_budget_s);
-  const v1::FreeSpaceCheck checks[] = {v1::FREE_SPACE_CHECK_AUTO, v1::FREE_SPACE_CHECK_ON, v1::FREE_SPACE_CHECK_OFF};
-  m->set_free_space(checks[static_cast<int>(p.free_space)]);
+  m->set_free_space(api::to_proto(p.free_space));
 }
 
 namespace {

@@ -222,6 +222,36 @@ TEST(ProtoConvert, UnsetFieldsTakeTheCoreDefaults) {
   EXPECT_EQ(code_of([&] { service::params_from_proto(m); }), ErrorCode::kInvalidArgument);
 }
 
+// What a coordinating replica sends its peers (params_to_proto) reads back as the same parameters, for every
+// value of every enum; a value the schema does not know is refused, naming the field.
+TEST(ProtoConvert, EveryEnumValueRoundTripsAndUnknownValuesAreRefused) {
+  for (const KeypointSignal signal : {KeypointSignal::kAuto, KeypointSignal::kIntensity, KeypointSignal::kGeometric}) {
+    for (const CoarseMethod method : {CoarseMethod::kKeypoint4pcs, CoarseMethod::kPlain4pcs}) {
+      for (const FreeSpaceCheck check : {FreeSpaceCheck::kAuto, FreeSpaceCheck::kOn, FreeSpaceCheck::kOff}) {
+        RegistrationParams p;
+        p.signal = signal;
+        p.method = method;
+        p.free_space = check;
+        v1::RegistrationParams m;
+        service::params_to_proto(p, &m);
+        const RegistrationParams q = service::params_from_proto(m);
+        EXPECT_EQ(q.signal, signal);
+        EXPECT_EQ(q.method, method);
+        EXPECT_EQ(q.free_space, check);
+      }
+    }
+  }
+  v1::RegistrationParams m;
+  m.set_free_space(static_cast<v1::FreeSpaceCheck>(42));
+  try {
+    service::params_from_proto(m);
+    ADD_FAILURE() << "an unknown free_space value was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(std::string(e.what()).find("params.free_space"), std::string::npos) << e.what();
+  }
+}
+
 TEST(StatusMapping, EveryCoreCodeHasItsGrpcCode) {
   EXPECT_EQ(service::to_grpc_code(ErrorCode::kInvalidArgument), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_EQ(service::to_grpc_code(ErrorCode::kNotFound), grpc::StatusCode::NOT_FOUND);
