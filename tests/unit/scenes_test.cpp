@@ -196,6 +196,22 @@ TEST(Scenes, ObjectScansAreAimedViewsWithoutIntensity) {
   EXPECT_EQ(simulate_scan(away, 0, params_with(2000)).cloud.size(), 0u);
 }
 
+TEST(Scenes, Object15IsTheStatuetteFromFifteenViewsEvery24Degrees) {
+  const Scene ring = make_scene("object15"), object = make_scene("object");
+  ASSERT_EQ(ring.stations.size(), 15u);
+  EXPECT_EQ(bounds_of(ring.primitives).sizes(), bounds_of(object.primitives).sizes()) << "the same statuette";
+  for (std::size_t i = 0; i < ring.stations.size(); ++i) {
+    const Vector3d from_centre = ring.stations[i].position_m - *ring.stations[i].look_at_m;
+    const double azimuth_deg = std::atan2(from_centre.y(), from_centre.x()) * 180.0 / M_PI;
+    EXPECT_NEAR(std::remainder(azimuth_deg - 24.0 * static_cast<double>(i), 360.0), 0.0, 1e-6) << i;
+  }
+  // Closer neighbours share more of the statuette than the ten views' do (object 0-1: 0.51).
+  const auto scan = [](const Scene& scene, int station) { return in_scene_frame(simulate_scan(scene, station, params_with(40000))); };
+  EXPECT_GT(overlap(scan(ring, 0), scan(ring, 1), 0.005), overlap(scan(object, 0), scan(object, 1), 0.005));
+  // Its layouts draw their own dice: object15's layout 3 is not object's with five more views.
+  EXPECT_NE(make_scene("object15", 3).stations[0].position_m, make_scene("object", 3).stations[0].position_m);
+}
+
 std::uint64_t checksum(const SimulatedScan& scan) {
   std::uint64_t h = 0xcbf29ce484222325ULL;
   auto add = [&](const void* data, std::size_t bytes) {
@@ -209,7 +225,7 @@ std::uint64_t checksum(const SimulatedScan& scan) {
 }
 
 TEST(Scenes, LayoutsAreReproducibleDistinctAndLeaveTheOldScenesAlone) {
-  for (const auto& name : {"hall", "corridor", "monument", "courtyard", "object"}) {
+  for (const auto& name : {"hall", "corridor", "monument", "courtyard", "object", "object15"}) {
     const Scene a = make_scene(name, 2), b = make_scene(name, 2), c = make_scene(name, 5), canonical = make_scene(name);
     ASSERT_EQ(a.stations.size(), canonical.stations.size()) << name;
     const std::size_t points = std::min<std::size_t>(20000, a.default_points);

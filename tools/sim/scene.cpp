@@ -26,12 +26,13 @@ Scene make_scene(const std::string& name, int layout) {
   if (name == "corridor") return make_corridor_scene(layout);
   if (name == "monument") return make_monument_scene(layout);
   if (name == "courtyard") return make_courtyard_scene(layout);
-  if (name == "object") return make_object_scene(layout);
+  if (name == "object") return make_object_scene(layout, 10);
+  if (name == "object15") return make_object_scene(layout, 15);
   std::string known;
   for (const auto& n : scene_names()) known += (known.empty() ? "" : ", ") + n;
   fail(ErrorCode::kInvalidArgument, "unknown scene '" + name + "' (known: " + known + ")");
 }
 
-std::vector<std::string> scene_names() { return {"lab", "arch", "hall", "corridor", "monument", "courtyard", "object"}; }
+std::vector<std::string> scene_names() { return {"lab", "arch", "hall", "corridor", "monument", "courtyard", "object", "object15"}; }
 
 }  // namespace k4reg::sim

@@ -70,6 +70,7 @@ Scene make_hall_scene(int layout);
 Scene make_corridor_scene(int layout);
 Scene make_monument_scene(int layout);
 Scene make_courtyard_scene(int layout);
-Scene make_object_scene(int layout);
+// views: 10 ("object") or 15 ("object15").
+Scene make_object_scene(int layout, int views);
 
 }  // namespace k4reg::sim

@@ -1,7 +1,7 @@
 // The "object" scene: a small statuette, ~0.2 m across (the Stanford bunny's size): a crouching body
 // on a plinth, a head with two unequal ears, a tail, paws and a staff, all ellipsoids, cylinders and
-// boxes. It is scanned by an object range scanner, not a TLS: ten stations every 36 deg around it,
-// 0.7 m away and alternately higher and lower, each a 35 deg camera-like frustum aimed at the
+// boxes. It is scanned by an object range scanner, not a TLS: ten stations every 36 deg around it
+// ("object15": fifteen every 24 deg, as a real statue set's), 0.7 m away and alternately higher and lower, each a 35 deg camera-like frustum aimed at the
 // statuette, with 0.15 mm range noise and no intensity. Nothing else is in the scene (no turntable), so
 // neighbouring views share only the surface both see at an angle, ~30-60 % of each, and the body's
 // near-symmetric ellipsoids admit many wrong fits: the small details must carry the registration.
@@ -17,8 +17,6 @@ namespace {
 
 using Eigen::Vector3d;
 
-constexpr int kStations = 10;
-constexpr double kStationStep_deg = 360.0 / kStations;
 constexpr double kDistance_m = 0.7;            // scanner to the statuette's centre
 constexpr double kHeightSwing_m = 0.12;        // stations alternate this much above and below the centre
 constexpr double kFieldOfView_deg = 35.0;
@@ -46,10 +44,16 @@ void add_statuette(std::vector<Primitive>& out, double s, double ear_shift_m, do
 
 }  // namespace
 
-Scene make_object_scene(int layout) {
-  LayoutDice dice("object", layout);
-  Scene scene = empty_scene("object", layout,
-                            "statuette ~0.2 m across, object range scanner: 10 views of 35 deg every 36 deg, 0.15 mm noise, no intensity", 2.0);
+Scene make_object_scene(int layout, int views) {
+  // Each ring of views has its own draws, so object15's layouts are not object's with more views.
+  const std::string name = views == 10 ? "object" : "object" + std::to_string(views);
+  const double step_deg = 360.0 / views;
+  LayoutDice dice(name, layout);
+  Scene scene = empty_scene(name, layout,
+                            "statuette ~0.2 m across, object range scanner: " + std::to_string(views) +
+                                " views of 35 deg every " + std::to_string(static_cast<int>(std::lround(step_deg))) +
+                                " deg, 0.15 mm noise, no intensity",
+                            2.0);
   scene.default_points = 40000;
   scene.default_noise_m = 0.00015;
   scene.intensity = false;
@@ -58,8 +62,8 @@ Scene make_object_scene(int layout) {
 
   const Vector3d target(0.0, 0.0, kCenterHeight_m * s);
   const double distance_m = kDistance_m * dice.scale(0.2);
-  for (int i = 0; i < kStations; ++i) {
-    const double azimuth_deg = i * kStationStep_deg + dice.shift(5.0);
+  for (int i = 0; i < views; ++i) {
+    const double azimuth_deg = i * step_deg + dice.shift(5.0);
     const double dz = (i % 2 == 0 ? 1.0 : -1.0) * kHeightSwing_m + dice.shift(0.03);
     const double a = azimuth_deg * kDegree;
     Station station;
