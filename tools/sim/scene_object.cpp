@@ -1,10 +1,11 @@
 // The "object" scene: a small statuette, ~0.2 m across (the Stanford bunny's size): a crouching body
 // on a plinth, a head with two unequal ears, a tail, paws and a staff, all ellipsoids, cylinders and
 // boxes. It is scanned by an object range scanner, not a TLS: ten stations every 36 deg around it
-// ("object15": fifteen every 24 deg, as a real statue set's), 0.7 m away and alternately higher and lower, each a 35 deg camera-like frustum aimed at the
-// statuette, with 0.15 mm range noise and no intensity. Nothing else is in the scene (no turntable), so
-// neighbouring views share only the surface both see at an angle, ~30-60 % of each, and the body's
-// near-symmetric ellipsoids admit many wrong fits: the small details must carry the registration.
+// ("object15": fifteen every 24 deg, as a real statue set's), 0.7 m away and alternately higher and
+// lower, each a 35 deg camera-like frustum aimed at the statuette, with 0.15 mm range noise and no
+// intensity. Nothing else is in the scene (no turntable), so neighbouring views share only the surface
+// both see at an angle, ~30-60 % of each, and the body's near-symmetric ellipsoids admit many wrong
+// fits: the small details must carry the registration.
 #include <cmath>
 #include <numbers>
 #include <string>
