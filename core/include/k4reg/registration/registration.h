@@ -1,6 +1,8 @@
 // K-4PCS pairwise registration (Theiler, Wegner, Schindler 2014), top to bottom:
 //   voxel grid (centroids, spacing = min scale)  ->  3D DoG keypoints  ->  keypoint 4PCS
-//   ->  symmetry guard (re-score the best distinct hypotheses on the voxelised clouds)  ->  ICP.
+//   ->  symmetry guard (re-score the best distinct hypotheses on the voxelised clouds)  ->  ICP;
+//   where a scale finds no well-supported pose: the same with the scans swapped, its pose judged again from the
+//   source's side; then the next, finer scale.
 // Cost: linear in the input points for the voxel grid; the rest depends on the voxel / keypoint counts.
 #pragma once
 
