@@ -262,6 +262,44 @@ TEST(ProjectRegistration, ScanTurnedAgainstAllOthersIsPlacedByWhatTheWinnersImpl
   }
 }
 
+// Registers each pair here, except that a search from scan 0's side finds nothing, as 4PCS can miss from the side
+// whose keypoints its partner does not repeat.
+class BlindFromScanZeroRunner : public PairRunner {
+ public:
+  void run(const std::vector<PreparedScan>& scans, const std::vector<ScanPair>& pairs, const RegistrationParams& params,
+           const CancellationToken* cancel, const Done& done) override {
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      PairOutcome outcome;
+      if (pairs[k].first == 0)
+        outcome.error = Error(ErrorCode::kFailedPrecondition, "no alignment found (test: blind from scan 0's side)");
+      else
+        outcome = register_pair(scans[pairs[k].first], scans[pairs[k].second], params, cancel);
+      searched.push_back(pairs[k]);
+      done(k, std::move(outcome));
+    }
+  }
+  std::vector<ScanPair> searched;
+};
+
+TEST(ProjectRegistration, PairsOfAnUnconfirmedScanAreSearchedAgainFromTheOtherSide) {
+  const BunnyProject bunny;
+  const std::vector<PointCloud> scans(bunny.scans.begin(), bunny.scans.begin() + 3);
+  BlindFromScanZeroRunner runner;
+  const ProjectResult r = register_project(scans, statue_params(), nullptr, {}, {}, &runner);
+  // The reference's two pairs failed from its side, so no loop confirmed it: both were searched again from the
+  // partners' side, and only they (1 -> 2 was confirmed by nothing either, but it found a well-supported pose).
+  EXPECT_EQ(runner.searched, (std::vector<ScanPair>{{0, 1}, {0, 2}, {1, 2}, {1, 0}, {2, 0}}));
+  ASSERT_EQ(r.links.size(), 3u);
+  EXPECT_EQ(r.links[0].source, 1u);  // swapped: the well-supported side's result
+  EXPECT_EQ(r.links[0].target, 0u);
+  EXPECT_EQ(r.links[1].source, 2u);
+  for (const ProjectLink& link : r.links) EXPECT_TRUE(link.accepted) << link.source << "->" << link.target << ": " << link.reason;
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_TRUE(r.scans[i].registered) << i << ": " << r.scans[i].reason;
+    EXPECT_LT(rms_error_m(scans[i], r.scans[i].pose, bunny.truth[i]), 0.001) << i;
+  }
+}
+
 TEST(ProjectRegistration, SameResultAtAnyThreadCount) {
   const BunnyProject bunny;
   std::vector<PointCloud> scans(bunny.scans.begin(), bunny.scans.begin() + 3);

@@ -289,6 +289,10 @@ TEST(Registration, APairThatTheSourceSideMissesIsFoundFromTheTargetSide) {
     return rotation_angle_deg(h.transform.topLeftCorner<3, 3>().transpose() * pair.T_target_source.topLeftCorner<3, 3>()) > 90.0;
   });
   EXPECT_GE(turned, 1);
+  // From the source's side alone, the turned pose wins.
+  p.search_other_side = false;
+  const RegistrationResult one_sided = register_clouds(source, target, p);
+  EXPECT_GT(transform_error(source.points, one_sided.transform, pair.T_target_source).rmse_m, kBunnySuccess_m);
 }
 
 // Many files carry an intensity field that says nothing (e.g. a constant): with the signal on auto, the

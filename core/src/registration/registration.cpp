@@ -660,7 +660,7 @@ RegistrationResult run(const PreparedScan& source, const PreparedScan& target, c
     try {
       ScaleAttempt attempt = register_at_scale(source, target, params, sigma, {}, cancel, progress);
       add_timings(timings, attempt.result.timings);
-      if (!attempt.supported)
+      if (!attempt.supported && params.search_other_side)
         if (std::optional<ScaleAttempt> other =
                 from_the_other_side(source, target, params, sigma, attempt.result, timings, cancel, progress))
           attempt = std::move(*other);

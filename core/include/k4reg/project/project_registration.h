@@ -1,8 +1,9 @@
 // Project registration: N scans into one frame (after Theiler, Wegner, Schindler 2015), top to bottom:
 //   candidate pairs (candidate_pairs.h; for large projects each scan's best partners, partner_screen.h)
 //   ->  pairwise K-4PCS per pair, keeping its distinct hypotheses (screened: then the next best partners of scans
-//   no loop confirms)  ->  links whose well-supported winner has a small margin judged from both sides
-//   (two_sided_margin.h)
+//   no loop confirms)  ->  the pairs of scans no loop confirms that found no well-supported pose, searched again
+//   with the scans swapped (4PCS draws its bases in the source)  ->  links whose well-supported winner has a small
+//   margin judged from both sides (two_sided_margin.h)
 //   ->  loop-consistent selection of one hypothesis per link (loop_closure.h)  ->  where a loop stays open,
 //   the poses its links imply judged on each link's own clouds (judge_poses), and the selection again
 //   ->  initial poses by consensus of the accepted links, from the reference out  ->  conflicts, minority
@@ -12,8 +13,8 @@
 // symmetric twin, is reported as not registered, never forced into place. Pairs run one after the other, each on all
 // threads (or wherever a PairRunner sends them), so the result is the same at any thread count and on any runner.
 // Cost: for screened pairs, one 4PCS round on keypoints per pair of scans (about 0.1 s at 1 M points); one
-// pairwise registration per candidate pair (0.2-3 s each at 1 M points on 2 cores; about twice that where a
-// scale finds no well-supported pose and the pair is searched from the other side too); judging implied
+// pairwise registration per candidate pair (0.2-3 s each at 1 M points on 2 cores), and one more per pair searched
+// from the other side (none where every scan closes a loop); judging implied
 // poses, a guard and a verdict per link in an open loop of well-supported links (0.1-1 s each), and as much per
 // weak link judged from both sides (2-4 s at 0.7 M points); selection and refinement take milliseconds.
 #pragma once

@@ -65,6 +65,12 @@ struct RegistrationParams {
   // rotation about z and a translation. Wrong for tilted scans (a handheld or mobile scanner).
   bool levelled = false;
 
+  // Where a scale finds no well-supported pose, search the pair again with the scans swapped (4PCS draws its
+  // bases in the source) and keep a pose found there if it is well supported from the source's side too.
+  // A project turns it off for its pairs: its loops confirm a link found from either side, and it searches
+  // the pairs of scans no loop confirms from the other side itself.
+  bool search_other_side = true;
+
   // ICP refinement.
   bool icp = true;
   int icp_max_iterations = 50;
