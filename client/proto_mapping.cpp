@@ -14,6 +14,7 @@ v1::RegistrationParams params_to_proto(const RegistrationParams& p, const Regist
   if (given(flags.min_scale)) m.set_min_scale_m(p.min_scale_m);
   if (given(flags.overlap)) m.set_overlap(p.overlap);
   if (given(flags.no_icp)) m.set_icp(p.icp);
+  if (given(flags.one_sided)) m.set_search_other_side(p.search_other_side);
   if (given(flags.levelled)) m.set_levelled(p.levelled);
   if (given(flags.seed)) m.set_seed(p.seed);
   if (given(flags.threads)) m.set_threads(p.threads);

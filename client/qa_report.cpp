@@ -42,6 +42,7 @@ nlohmann::json params_to_json(const RegistrationParams& p) {
           {"hypotheses_kept", p.hypotheses_kept},
           {"free_space", free_space[static_cast<int>(p.free_space)]},
           {"levelled", p.levelled},
+          {"search_other_side", p.search_other_side},
           {"icp", p.icp},
           {"icp_max_iterations", p.icp_max_iterations},
           {"seed", p.seed},

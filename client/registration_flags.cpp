@@ -18,6 +18,10 @@ RegistrationFlags add_registration_flags(CLI::App& command, RegistrationParams& 
                                   "0.8, then 0.6, then 0.4 until a pose is well supported)")
                       ->check(CLI::Range(0.05, 1.0));
   flags.no_icp = command.add_flag("--no-icp{false}", params.icp, "skip the ICP refinement (coarse K-4PCS result only)");
+  flags.one_sided = command.add_flag(
+      "--one-sided{false}", params.search_other_side,
+      "search each pair from the source's side only (by default a scale that finds no well-supported pose "
+      "searches the pair again with the scans swapped)");
   flags.levelled = command.add_flag("--levelled", params.levelled,
                                     "the scanners were levelled (z axes vertical, as a tilt compensator makes them): "
                                     "only rotations about z are searched and refined");

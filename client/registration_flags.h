@@ -10,7 +10,7 @@ namespace k4reg::cli {
 
 // The option behind each flag, so a remote command can tell which ones the user gave (Option::count()).
 struct RegistrationFlags {
-  CLI::Option *min_scale, *overlap, *no_icp, *levelled, *seed, *threads, *time_budget, *bases, *octaves, *scales_per_octave,
+  CLI::Option *min_scale, *overlap, *no_icp, *one_sided, *levelled, *seed, *threads, *time_budget, *bases, *octaves, *scales_per_octave,
       *min_contrast, *signal, *free_space, *method, *plain_voxel;
 };
 

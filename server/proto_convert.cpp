@@ -40,6 +40,7 @@ RegistrationParams params_from_proto(const v1::RegistrationParams& m) {
   if (m.has_hypotheses_kept()) p.hypotheses_kept = m.hypotheses_kept();
   if (m.has_icp()) p.icp = m.icp();
   if (m.has_levelled()) p.levelled = m.levelled();
+  if (m.has_search_other_side()) p.search_other_side = m.search_other_side();
   if (m.has_icp_max_iterations()) p.icp_max_iterations = m.icp_max_iterations();
   if (m.has_seed()) p.seed = m.seed();
   if (m.has_threads()) p.threads = m.threads();
@@ -143,6 +144,7 @@ void params_to_proto(const RegistrationParams& p, v1::RegistrationParams* m) {
   m->set_hypotheses_kept(p.hypotheses_kept);
   m->set_icp(p.icp);
   m->set_levelled(p.levelled);
+  m->set_search_other_side(p.search_other_side);
   m->set_icp_max_iterations(p.icp_max_iterations);
   m->set_seed(p.seed);
   m->set_threads(p.threads);

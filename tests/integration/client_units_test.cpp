@@ -112,6 +112,10 @@ TEST(RegistrationFlagsToProto, OnlyTheGivenFlagsAreSent) {
   EXPECT_FALSE(none.has_min_scale_m());
   EXPECT_EQ(none.free_space(), v1::FREE_SPACE_CHECK_UNSPECIFIED);
   EXPECT_EQ(none.signal(), v1::KEYPOINT_SIGNAL_UNSPECIFIED);
+  EXPECT_FALSE(none.has_search_other_side());
+  const v1::RegistrationParams one_sided = parse({"--one-sided"});
+  EXPECT_TRUE(one_sided.has_search_other_side());
+  EXPECT_FALSE(one_sided.search_other_side());
 
   EXPECT_EQ(parse({"--free-space", "off"}).free_space(), v1::FREE_SPACE_CHECK_OFF);
   EXPECT_EQ(parse({"--free-space", "ON"}).free_space(), v1::FREE_SPACE_CHECK_ON);

@@ -197,6 +197,7 @@ TEST(ProtoConvert, UnsetFieldsTakeTheCoreDefaults) {
   EXPECT_EQ(p.min_scale_m, 0.0);  // automatic
   EXPECT_EQ(p.overlap, 0.0);      // automatic
   EXPECT_TRUE(p.icp);
+  EXPECT_TRUE(p.search_other_side);
   EXPECT_EQ(p.seed, defaults.seed);
   EXPECT_EQ(p.octaves, defaults.octaves);
   EXPECT_EQ(p.hypotheses_kept, defaults.hypotheses_kept);
@@ -210,8 +211,10 @@ TEST(ProtoConvert, UnsetFieldsTakeTheCoreDefaults) {
   m.set_signal(v1::KEYPOINT_SIGNAL_INTENSITY);
   m.set_method(v1::COARSE_METHOD_PLAIN_4PCS);
   m.set_time_budget_s(3);
+  m.set_search_other_side(false);
   const RegistrationParams q = service::params_from_proto(m);
   EXPECT_FALSE(q.icp);
+  EXPECT_FALSE(q.search_other_side);
   EXPECT_EQ(q.seed, 7u);
   EXPECT_EQ(q.min_scale_m, 0.1);
   EXPECT_EQ(q.signal, KeypointSignal::kIntensity);
@@ -241,6 +244,11 @@ TEST(ProtoConvert, EveryEnumValueRoundTripsAndUnknownValuesAreRefused) {
       }
     }
   }
+  RegistrationParams one_sided;  // as a project sends its pairs
+  one_sided.search_other_side = false;
+  v1::RegistrationParams sent;
+  service::params_to_proto(one_sided, &sent);
+  EXPECT_FALSE(service::params_from_proto(sent).search_other_side);
   v1::RegistrationParams m;
   m.set_free_space(static_cast<v1::FreeSpaceCheck>(42));
   try {

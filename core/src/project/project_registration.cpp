@@ -217,6 +217,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
                                            std::chrono::duration<double>(params.pairwise.time_budget_s)));
   RegistrationParams pairwise = params.pairwise;
   pairwise.time_budget_s = 0.0;  // the project's deadline covers every pair
+  pairwise.search_other_side = false;  // the project's own rule below, for the pairs of scans no loop confirms
 
   ProjectResult r;
   r.reference = params.reference;

@@ -1,6 +1,8 @@
 // K-4PCS pairwise registration (Theiler, Wegner, Schindler 2014), top to bottom:
 //   voxel grid (centroids, spacing = min scale)  ->  3D DoG keypoints  ->  keypoint 4PCS
-//   ->  symmetry guard (re-score the best distinct hypotheses on the voxelised clouds)  ->  ICP.
+//   ->  symmetry guard (re-score the best distinct hypotheses on the voxelised clouds)  ->  ICP;
+//   where a scale finds no well-supported pose: the same with the scans swapped, its pose judged again from the
+//   source's side; then the next, finer scale.
 // Cost: linear in the input points for the voxel grid; the rest depends on the voxel / keypoint counts.
 #pragma once
 
@@ -62,6 +64,12 @@ struct RegistrationParams {
   // refined, so no out-of-plane flip can win, and fewer 4PCS sets pass the fit. Every transform is then a
   // rotation about z and a translation. Wrong for tilted scans (a handheld or mobile scanner).
   bool levelled = false;
+
+  // Where a scale finds no well-supported pose, search the pair again with the scans swapped (4PCS draws its
+  // bases in the source) and keep a pose found there if it is well supported from the source's side too.
+  // A project turns it off for its pairs: its loops confirm a link found from either side, and it searches
+  // the pairs of scans no loop confirms from the other side itself.
+  bool search_other_side = true;
 
   // ICP refinement.
   bool icp = true;
