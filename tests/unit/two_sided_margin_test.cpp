@@ -69,6 +69,27 @@ TEST_F(HallOppositeCorners, TargetsSideTurnsATieIntoTheTruthWhicheverCandidateCa
   }
 }
 
+// A runner-up the target's side does not refine (here one 200 m away, with nothing to match) is no evidence
+// for the winner: scored 0, it gave a reverse margin of 1 (a corridor's half turn over a runner-up that was not
+// the truth either, so a project placed the scan 180 deg off). The winner is weighed against the best pose refined
+// there instead: in this hall, the truth's half turn, which station 1 tells from the truth by a few hundredths.
+TEST_F(HallOppositeCorners, ARunnerUpTheTargetsSideDoesNotRefineIsNoEvidence) {
+  const PreparedScan source(a_->cloud), target(b_->cloud);
+  Eigen::Matrix4d away = truth();
+  away(0, 3) += 200.0;
+  LinkCandidates link{0, 1, {truth(), away}, 0.2, true, 0.01, true, {0.9, 0.89}};
+  RegistrationParams params;
+  params.min_scale_m = 0.1;
+  params.overlap = 0.4;
+  const TwoSidedJudgement j = judge_from_both_sides(source, target, link, params, {20.0, 20.0});
+  EXPECT_TRUE(j.judged);
+  EXPECT_FALSE(j.runner_up_preferred);
+  EXPECT_GT(j.reverse_margin, 0.0);
+  EXPECT_LT(j.reverse_margin, 0.2);
+  EXPECT_TRUE(link.ambiguous);
+  EXPECT_TRUE(link.transforms.front().isApprox(truth()));
+}
+
 TEST_F(HallOppositeCorners, ALinkWithOneCandidateIsNotJudged) {
   const PreparedScan source(a_->cloud), target(b_->cloud);
   LinkCandidates link{0, 1, {truth()}, 0.2, false, 1.0, true, {1.0}};

@@ -20,15 +20,17 @@
 namespace k4reg {
 
 struct TwoSidedJudgement {
-  bool judged = false;               // false: not judged (fewer than two candidates, or the judgement failed)
+  bool judged = false;  // false: not judged (fewer than two candidates, a candidate not refined there, or a failure)
   bool runner_up_preferred = false;  // the two sides together preferred the pairwise runner-up
-  double reverse_margin = 0.0;       // from the target's side, the (new) first candidate over the second (signed)
+  double reverse_margin = 0.0;       // from the target's side, the (new) first candidate over its best rival (signed)
   double margin = 0.0;               // both sides' margins added, the first candidate over the second (>= 0)
 };
 
 // Judges candidates 0 and 1 of `link` (the pairwise winner and runner-up, with their scores) from the target's
-// side: the scans swapped, the two poses inverted, judge_poses at params' scale and overlap. Each side's margin is
-// (first - second) / the larger of the two scores; a pose that does not survive the refinement there scores 0.
+// side: the scans swapped, the two poses inverted, judge_poses at params' scale and overlap. The source's margin
+// is (first - second) / the larger of their scores; the target's, the winner's refined score there against the
+// best refined pose there that stands for anything else (the runner-up, or a twin the guard added). Where the
+// winner or every rival is not refined there, the link is not judged.
 // Reorders the two where their sum is negative and sets link.margin and link.ambiguous to the two-sided verdict.
 // Rethrows cancellation; another failure leaves the link as it was (judged = false).
 TwoSidedJudgement judge_from_both_sides(const PreparedScan& source, const PreparedScan& target, LinkCandidates& link,
