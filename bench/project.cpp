@@ -60,6 +60,9 @@ struct Run {
   std::uint64_t seed = 0;
   std::size_t scans = 0, correct = 0, unregistered = 0, confident_misses = 0, links = 0, accepted = 0;
   std::size_t loops = 0, inconsistent = 0;
+  // Of the unregistered scans, those held too weakly whose two candidate placements came with them, and how many
+  // of those the preferred (first) placement put right.
+  std::size_t ambiguous = 0, ambiguous_preferred_right = 0;
   double worst_rmse_m = 0.0, seconds = 0.0;
   double read_seconds = 0.0;
   std::vector<StageTiming> timings;  // the project's: pairwise stages summed over pairs, selection, refinement
@@ -245,12 +248,23 @@ Run run_one(const Suite& suite, std::uint64_t seed) {
     run.timings = r.timings;
     const Eigen::Matrix4d to_reference = project.truth[r.reference].inverse();
     for (std::size_t i = 0; i < r.scans.size(); ++i) {
+      auto error_m = [&](const Eigen::Matrix4d& pose) {
+        return file_frame_error(project.scans[i], pose, to_reference * project.truth[i]).rmse_m;
+      };
       if (!r.scans[i].registered) {
         ++run.unregistered;
         run.note += fmt::format(" {}:unregistered", i);
+        if (r.scans[i].ambiguous && !r.scans[i].candidate_poses.empty()) {
+          ++run.ambiguous;
+          std::vector<std::string> right;
+          for (std::size_t k = 0; k < r.scans[i].candidate_poses.size(); ++k)
+            if (error_m(r.scans[i].candidate_poses[k]) < suite.success_rmse_m) right.push_back(k == 0 ? "preferred" : "twin");
+          run.ambiguous_preferred_right += !right.empty() && right.front() == "preferred";
+          run.note += fmt::format(" (ambiguous: {} right)", right.empty() ? "neither" : fmt::format("{}", fmt::join(right, "+")));
+        }
         continue;
       }
-      const double rmse = file_frame_error(project.scans[i], r.scans[i].pose, to_reference * project.truth[i]).rmse_m;
+      const double rmse = error_m(r.scans[i].pose);
       run.worst_rmse_m = std::max(run.worst_rmse_m, rmse);
       if (rmse < suite.success_rmse_m) {
         ++run.correct;
@@ -279,18 +293,23 @@ std::string report(const std::vector<Suite>& suites, const std::vector<Run>& run
     for (const Suite& s : suites) {
       if (s.part != part) continue;
       std::size_t n = 0, scans = 0, correct = 0, unregistered = 0, confident = 0, links = 0, accepted = 0;
+      std::size_t ambiguous = 0, preferred_right = 0;
       double worst = 0.0;
       std::vector<double> times;
       for (const Run& r : runs) {
         if (r.suite != s.name) continue;
         ++n, scans += r.scans, correct += r.correct, confident += r.confident_misses, links += r.links, accepted += r.accepted;
         unregistered += r.refused ? r.scans : r.unregistered;
+        ambiguous += r.ambiguous, preferred_right += r.ambiguous_preferred_right;
         worst = std::max(worst, r.worst_rmse_m);
         times.push_back(r.seconds);
       }
       if (n == 0) continue;
+      const std::string not_registered =
+          ambiguous == 0 ? fmt::format("{}", unregistered)
+                         : fmt::format("{} ({} ambiguous, preferred right {})", unregistered, ambiguous, preferred_right);
       out << fmt::format("| {} | {} | {} | {} | {} | {} ({:.0f} %) | {} | **{}** | {:.3g} m (limit {:g}) | {} / {} | {:.1f} s |\n",
-                         part, s.name, s.what, n, scans, correct, 100.0 * correct / scans, unregistered, confident, worst,
+                         part, s.name, s.what, n, scans, correct, 100.0 * correct / scans, not_registered, confident, worst,
                          s.success_rmse_m, accepted, links, median(times));
     }
   return out.str();
@@ -347,7 +366,7 @@ int main(int argc, char** argv) {
     const bool scaling = o.part == "scaling";
     std::ofstream csv(fs::path(o.results_dir) / (scaling ? "project-scaling-runs.csv" : "project-runs.csv"));
     csv << "part,project,seed,scans,correct,unregistered,confident_misses,refused,worst_rmse_m,links,accepted,loops,"
-           "loops_inconsistent,seconds,note\n";
+           "loops_inconsistent,seconds,ambiguous,ambiguous_preferred_right,note\n";
     for (const Suite& s : suites) {
       if (!o.selected(s.part, s.name)) continue;
       for (int seed = 1; seed <= o.seeds; ++seed) {
@@ -360,7 +379,8 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
         csv << r.part << ',' << r.suite << ',' << seed << ',' << r.scans << ',' << r.correct << ',' << r.unregistered << ','
             << r.confident_misses << ',' << r.refused << ',' << r.worst_rmse_m << ',' << r.links << ',' << r.accepted << ','
-            << r.loops << ',' << r.inconsistent << ',' << r.seconds << ",\"" << r.note << "\"\n";
+            << r.loops << ',' << r.inconsistent << ',' << r.seconds << ',' << r.ambiguous << ','
+            << r.ambiguous_preferred_right << ",\"" << r.note << "\"\n";
       }
     }
     const std::string table = scaling ? scaling_report(runs) : report(suites, runs);

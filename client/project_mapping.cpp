@@ -17,6 +17,9 @@ ProjectResult project_result_from_proto(const v1::ProjectResult& m) {
     scan.strength = s.strength();
     scan.constraint = api::constraint_from_proto(s.constraint());
     scan.reason = s.reason();
+    scan.ambiguous = s.ambiguous();
+    for (const v1::ScanPlacement& placement : s.candidate_poses())
+      if (placement.pose_size() == 16) scan.candidate_poses.push_back(api::matrix_from_proto(placement.pose()));
     r.scans.push_back(std::move(scan));
   }
   for (const v1::ProjectLink& l : m.links()) {

@@ -21,6 +21,8 @@ nlohmann::json project_to_json(const ProjectResult& r, const std::vector<ScanOri
   j["scans"] = nlohmann::json::array();
   for (std::size_t i = 0; i < r.scans.size(); ++i) {
     const ProjectScan& s = r.scans[i];
+    nlohmann::json candidate_poses = nlohmann::json::array();
+    for (const Eigen::Matrix4d& pose : s.candidate_poses) candidate_poses.push_back({{"pose", matrix_to_json(pose)}});  // as the proto's JSON
     j["scans"].push_back({{"file", origins.at(i).file},
                           {"scan_in_file", origins.at(i).scan},
                           {"pose", s.registered ? matrix_to_json(s.pose) : nlohmann::json(nullptr)},
@@ -30,7 +32,9 @@ nlohmann::json project_to_json(const ProjectResult& r, const std::vector<ScanOri
                           {"strength", s.strength},
                           {"axis_constraint", axis_constraint(s.constraint)},
                           {"weakest_constraint", weakest_constraint(s.constraint)},
-                          {"reason", s.reason}});
+                          {"reason", s.reason},
+                          {"ambiguous", s.ambiguous},
+                          {"candidate_poses", candidate_poses}});
   }
   j["links"] = nlohmann::json::array();
   for (const ProjectLink& l : r.links)
@@ -91,6 +95,9 @@ void print_project_table(std::ostream& out, const ProjectResult& r, const std::v
                                                   weakest_constraint(s.constraint))
                                     : "NOT registered: " + s.reason);
     if (s.registered) out << format_matrix4(s.pose);
+    for (std::size_t k = 0; k < s.candidate_poses.size(); ++k)
+      out << fmt::format("  candidate placement {}{}:\n", k + 1, k == 0 ? " (its links prefer it)" : " (the twin)")
+          << format_matrix4(s.candidate_poses[k]);
   }
   out << fmt::format("{:<6}{:<10}{:>9}{:>9}{:>8}{:>8}{:>12}{:>12}  {}\n", "link", "scans", "rmse m", "overlap", "margin",
                      "loops", "loop res m", "residual m", "verdict");

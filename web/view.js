@@ -1359,6 +1359,17 @@
         box.appendChild(el('div', { class: 'pose-item' }, [el('h3', null, [el('span', { class: 'swatch', style: { background: colorOfScan(i) } }), 'Scan ' + i + ': ' + (sc.file || '')]),
           matrixBlock(P, sc.pose, { class: 'matrix pose', 'data-scan': String(i) })]));
       });
+      /* scans held too weakly: not registered, both placements the evidence leaves open */
+      (R.scans || []).forEach(function (sc, i) {
+        if (!truthy(sc.ambiguous) || !Array.isArray(sc.candidate_poses)) return;
+        sc.candidate_poses.forEach(function (c, k) {
+          var values = c && c.pose, C = mat4(values);
+          if (!C) return;
+          box.appendChild(el('div', { class: 'pose-item candidate' }, [el('h3', null, [el('span', { class: 'swatch', style: { background: colorOfScan(i) } }),
+            'Scan ' + i + ': ' + (sc.file || '') + ' – NOT registered, ambiguous: ' + (k === 0 ? 'placement its links prefer' : 'twin placement')]),
+            matrixBlock(C, values, { class: 'matrix candidate-pose', 'data-scan': String(i), 'data-candidate': String(k) })]));
+        });
+      });
       if (!box.children.length) box.appendChild(el('p', { class: 'muted', text: 'No registered scans.' }));
       s.appendChild(box);
       return s;

@@ -1,14 +1,18 @@
-// Parts of the k4reg command line that need no server: latency statistics, --server parsing and the mapping of
-// registration flags to the request.
+// Parts of the k4reg command line that need no server: latency statistics, --server parsing, the mapping of
+// registration flags to the request, and a project result as the service sends it back.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <numeric>
+#include <sstream>
 #include <stdexcept>
 
 #include "channel.h"
 #include "latency_stats.h"
 #include "progress_bar.h"
+#include "project_convert.h"
+#include "project_mapping.h"
+#include "project_report.h"
 #include "proto_mapping.h"
 
 namespace k4reg::cli {
@@ -124,6 +128,45 @@ TEST(RegistrationFlagsToProto, OnlyTheGivenFlagsAreSent) {
   EXPECT_DOUBLE_EQ(given.min_scale_m(), 0.05);
   EXPECT_EQ(given.signal(), v1::KEYPOINT_SIGNAL_GEOMETRIC);
   EXPECT_THROW(parse({"--free-space", "sometimes"}), CLI::ValidationError);
+}
+
+// An ambiguous scan's two placements reach `register-project` as they left the core, and its --json, table and
+// --out-dir say it as `align-project`'s do: no pose, no pose file, both candidates.
+TEST(ProjectResultFromProto, AnAmbiguousScanKeepsItsTwoCandidatePlacements) {
+  ProjectResult core;
+  core.scans.resize(2);
+  core.scans[0].registered = true;
+  Eigen::Matrix4d preferred = Eigen::Matrix4d::Identity(), twin = Eigen::Matrix4d::Identity();
+  preferred(0, 3) = 5.0;
+  twin.topLeftCorner<2, 2>() << -1, 0, 0, -1;
+  twin(0, 3) = 15.0;
+  core.scans[1].ambiguous = true;
+  core.scans[1].candidate_poses = {preferred, twin};
+  core.scans[1].strength = 0.049;
+  core.scans[1].reason = "held too weakly";
+  v1::ProjectResult message;
+  service::project_result_to_proto(core, {"a.ply", "b.ply"}, &message);
+  ASSERT_EQ(message.scans(1).candidate_poses_size(), 2);
+  EXPECT_EQ(message.scans(1).pose_size(), 0);  // not registered: no pose
+  EXPECT_EQ(message.scans(0).candidate_poses_size(), 0);
+  const ProjectResult back = project_result_from_proto(message);
+  EXPECT_FALSE(back.scans[1].registered);
+  EXPECT_TRUE(back.scans[1].ambiguous);
+  ASSERT_EQ(back.scans[1].candidate_poses.size(), 2u);
+  EXPECT_EQ(back.scans[1].candidate_poses[0], preferred);
+  EXPECT_EQ(back.scans[1].candidate_poses[1], twin);
+  EXPECT_FALSE(back.scans[0].ambiguous);
+
+  const std::vector<ScanOrigin> origins{{"a.ply", -1}, {"b.ply", -1}};
+  const nlohmann::json json = project_to_json(back, origins, ProjectParams{});
+  EXPECT_TRUE(json["scans"][1]["pose"].is_null());
+  EXPECT_TRUE(json["scans"][1]["ambiguous"].get<bool>());
+  ASSERT_EQ(json["scans"][1]["candidate_poses"].size(), 2u);
+  EXPECT_EQ(json["scans"][1]["candidate_poses"][1]["pose"][3].get<double>(), 15.0);  // as the proto's JSON: {"pose": [...]}
+  EXPECT_TRUE(json["scans"][0]["candidate_poses"].empty());
+  std::ostringstream table;
+  print_project_table(table, back, origins);
+  EXPECT_NE(table.str().find("candidate placement 2 (the twin)"), std::string::npos) << table.str();
 }
 
 }  // namespace

@@ -168,7 +168,7 @@ TEST_F(HttpApi, OpenApiSchemasMatchTheProtoMessages) {
                                             "ProjectResult", "ProjectScan", "QueuedEvent", "RegisterProjectEvent",
                                             "RegisterProjectRequest", "RegisterProjectResponse", "RegisterRequest",
                                             "RegisterResponse", "RegisterStreamResponse", "RegistrationParams",
-                                            "RegistrationResult", "ScanPair", "ServerInfo", "ServerTimings",
+                                            "RegistrationResult", "ScanPair", "ScanPlacement", "ServerInfo", "ServerTimings",
                                             "StageEvent", "StageTiming"}));
 }
 

@@ -15,6 +15,7 @@
 #include "k4reg/project/pose_graph.h"
 #include "k4reg/project/scan_conflicts.h"
 #include "k4reg/project/scan_strength.h"
+#include "k4reg/project/twin_placement.h"
 #include "k4reg/project/two_sided_margin.h"
 #include "k4reg/registration/translation_constraint.h"
 #include "k4reg/util/error.h"
@@ -58,7 +59,12 @@ Eigen::Matrix4d proposed_pose(const ProjectResult& r, const ProjectLink& link, s
 // link that slipped through the loops is outvoted here rather than carried along a spanning tree. Scans
 // that never gain a majority stay unregistered.
 void place_scans(ProjectResult& r, const std::vector<double>& radius) {
-  for (ProjectScan& scan : r.scans) scan.registered = false, scan.pose = Eigen::Matrix4d::Identity(), scan.reason.clear();
+  for (ProjectScan& scan : r.scans) {
+    scan.registered = scan.ambiguous = false;
+    scan.pose = Eigen::Matrix4d::Identity();
+    scan.reason.clear();
+    scan.candidate_poses.clear();
+  }
   r.scans[r.reference].registered = true;
   using Key = std::tuple<std::size_t, int, double, std::size_t>;  // votes, loops closed, score, -link
   for (;;) {
@@ -470,15 +476,23 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     // Scans held too weakly to tell from a symmetric twin leave the project, with their links.
     std::vector<WeightedLink> weighted;
     for (std::size_t l : used) weighted.push_back({r.links[l].source, r.links[l].target, strength_weight(r.links[l])});
-    const std::vector<double> strength = scan_strengths(r.scans.size(), weighted, r.reference, 1.0);
+    const std::vector<ScanHold> holds = scan_holds(r.scans.size(), weighted, r.reference, 1.0);
+    std::vector<std::optional<Eigen::Matrix4d>> twins(r.scans.size());  // before any placement changes
+    for (std::size_t i = 0; i < r.scans.size(); ++i)
+      if (r.scans[i].registered && holds[i].strength > 0 && holds[i].strength < kAmbiguousMargin)
+        twins[i] = twin_placement(r, candidates, used, holds[i].moves_with, i);
     for (std::size_t i = 0; i < r.scans.size(); ++i) {
-      r.scans[i].strength = r.scans[i].registered ? strength[i] : 0.0;
-      if (r.scans[i].registered && strength[i] < kAmbiguousMargin) {
-        r.scans[i].registered = false;
-        r.scans[i].reason = fmt::format(
-            "held too weakly: its links' pairwise margins (strength {:.3f} < {}) cannot tell it from a symmetric twin",
-            strength[i], kAmbiguousMargin);
-      }
+      ProjectScan& scan = r.scans[i];
+      scan.strength = scan.registered ? holds[i].strength : 0.0;
+      if (!scan.registered || holds[i].strength >= kAmbiguousMargin) continue;
+      scan.registered = false;
+      scan.reason = fmt::format(
+          "held too weakly: its links' pairwise margins (strength {:.3f} < {}) cannot tell it from a symmetric twin",
+          holds[i].strength, kAmbiguousMargin);
+      if (!twins[i]) continue;
+      scan.ambiguous = true;
+      scan.candidate_poses = {scan.pose, *twins[i]};
+      scan.reason += "; both placements are given, the one its links prefer first";
     }
     for (std::size_t e = used.size(); e-- > 0;) {
       const ProjectLink& link = r.links[used[e]];

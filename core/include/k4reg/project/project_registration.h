@@ -84,6 +84,13 @@ struct ProjectScan {
   // capped at 1; under kAmbiguousMargin it is not registered.
   double strength = 0.0;
   std::string reason;  // why not registered, in words
+  // Held too weakly to tell from a twin placement (0 < strength < kAmbiguousMargin): not registered, but the
+  // evidence's two answers are given. candidate_poses: where its links place it (what the evidence prefers, by
+  // `strength`), then where it goes when the scans that move with it (the weak side of the cheapest cut) take
+  // their twin placements, by the runner-up of the cut's link that loses least by it. As the links place them,
+  // not refined. Empty, and ambiguous false, otherwise.
+  bool ambiguous = false;
+  std::vector<Eigen::Matrix4d> candidate_poses;
   // How firmly its links in the refined project pin its translation, in the project's frame: their constraints
   // added and scaled to trace 3 (translation_constraint.h); zero when not registered or linked.
   Eigen::Matrix3d constraint = Eigen::Matrix3d::Zero();

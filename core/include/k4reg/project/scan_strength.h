@@ -20,9 +20,15 @@ struct WeightedLink {
   double weight = 0.0;       // >= 0
 };
 
-// Per scan, the minimum cut between it and `reference` over the links, capped at `cap` (the reference
-// itself gets `cap`).
-std::vector<double> scan_strengths(std::size_t scans, const std::vector<WeightedLink>& links, std::size_t reference,
-                                   double cap);
+struct ScanHold {
+  double strength = 0.0;  // the minimum cut between the scan and the reference, capped
+  // Where the cut is under the cap: the scans on the scan's side of a minimum cut (it among them, ascending),
+  // the set whose move to its twin placements costs `strength`. Empty where the cut reaches the cap.
+  std::vector<std::size_t> moves_with;
+};
+
+// Per scan, how it is held to `reference` over the links (the reference itself: `cap`, moving with nothing).
+std::vector<ScanHold> scan_holds(std::size_t scans, const std::vector<WeightedLink>& links, std::size_t reference,
+                                 double cap);
 
 }  // namespace k4reg
