@@ -14,8 +14,7 @@
 #include "k4reg/project/partner_screen.h"
 #include "k4reg/project/pose_graph.h"
 #include "k4reg/project/scan_conflicts.h"
-#include "k4reg/project/scan_strength.h"
-#include "k4reg/project/twin_placement.h"
+#include "k4reg/project/twin_motion.h"
 #include "k4reg/project/two_sided_margin.h"
 #include "k4reg/registration/translation_constraint.h"
 #include "k4reg/util/error.h"
@@ -95,15 +94,6 @@ void place_scans(ProjectResult& r, const std::vector<double>& radius) {
     if (!scan.registered)
       scan.reason = scan.links.empty() ? "no accepted link connects it to the others (see its links' reasons)"
                                        : "its accepted links do not agree on where it goes, or reach the reference";
-}
-
-// A link's weight in the scans' strength: its margin (two-sided where judged from both sides) where its first
-// candidate was chosen and is well supported, at least one pair's worth where a vouching loop confirmed it, else
-// nothing.
-double strength_weight(const ProjectLink& link) {
-  const double margin = link.reverse_judged ? link.two_sided_margin : link.ambiguity_margin;
-  const double weight = link.candidate == 0 && link.well_supported ? margin : 0.0;
-  return link.verdict == "confirmed" ? std::max(weight, kAmbiguousMargin) : weight;
 }
 
 // Rejects an accepted link: it leaves its scans' lists.
@@ -473,25 +463,19 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     // Scans that a confident pairwise result contradicts leave the project (scan_conflicts.h).
     refuse_conflicted_scans(r, radius);
     refuse_minority_placements(r);
-    // Scans held too weakly to tell from a symmetric twin leave the project, with their links.
-    std::vector<WeightedLink> weighted;
-    for (std::size_t l : used) weighted.push_back({r.links[l].source, r.links[l].target, strength_weight(r.links[l])});
-    const std::vector<ScanHold> holds = scan_holds(r.scans.size(), weighted, r.reference, 1.0);
-    std::vector<std::optional<Eigen::Matrix4d>> twins(r.scans.size());  // before any placement changes
-    for (std::size_t i = 0; i < r.scans.size(); ++i)
-      if (r.scans[i].registered && holds[i].strength > 0 && holds[i].strength < kAmbiguousMargin)
-        twins[i] = twin_placement(r, candidates, used, holds[i].moves_with, i);
+    // Scans held too weakly to tell from a twin placement leave the project, with their links (twin_motion.h).
+    const std::vector<TwinHold> holds = holds_against_twins(r, candidates, used, radius, 1.0);
     for (std::size_t i = 0; i < r.scans.size(); ++i) {
       ProjectScan& scan = r.scans[i];
       scan.strength = scan.registered ? holds[i].strength : 0.0;
       if (!scan.registered || holds[i].strength >= kAmbiguousMargin) continue;
       scan.registered = false;
       scan.reason = fmt::format(
-          "held too weakly: its links' pairwise margins (strength {:.3f} < {}) cannot tell it from a symmetric twin",
+          "held too weakly: its links' margins (strength {:.3f} < {}) cannot tell it from a twin placement",
           holds[i].strength, kAmbiguousMargin);
-      if (!twins[i]) continue;
+      if (!holds[i].motion || holds[i].strength <= 0.0) continue;
       scan.ambiguous = true;
-      scan.candidate_poses = {scan.pose, *twins[i]};
+      scan.candidate_poses = {scan.pose, *holds[i].motion * scan.pose};
       scan.reason += "; both placements are given, the one its links prefer first";
     }
     for (std::size_t e = used.size(); e-- > 0;) {

@@ -7,7 +7,7 @@
 //   ->  loop-consistent selection of one hypothesis per link (loop_closure.h)  ->  where a loop stays open,
 //   the poses its links imply judged on each link's own clouds (judge_poses), and the selection again
 //   ->  initial poses by consensus of the accepted links, from the reference out  ->  conflicts, minority
-//   placements (scan_conflicts.h) and each scan's strength (scan_strength.h)  ->  global refinement
+//   placements (scan_conflicts.h) and each scan's strength (scan_strength.h, twin_motion.h)  ->  global refinement
 //   (pose_graph.h), where a link that disagrees with the refined project is dropped and the rest solved again.
 // A scan that no majority of accepted links places, or that they hold too weakly to tell it from a
 // symmetric twin, is reported as not registered, never forced into place. Pairs run one after the other, each on all
@@ -80,15 +80,14 @@ struct ProjectScan {
   bool registered = false;
   std::vector<std::size_t> links;  // accepted links touching it (indices into ProjectResult::links)
   std::size_t points = 0;
-  // How firmly the accepted links hold it to the reference beyond what symmetry can copy (scan_strength.h),
-  // capped at 1; under kAmbiguousMargin it is not registered.
+  // How firmly the accepted links hold it to the reference beyond what symmetry can copy (scan_strength.h,
+  // twin_motion.h), capped at 1; under kAmbiguousMargin it is not registered.
   double strength = 0.0;
   std::string reason;  // why not registered, in words
   // Held too weakly to tell from a twin placement (0 < strength < kAmbiguousMargin): not registered, but the
   // evidence's two answers are given. candidate_poses: where its links place it (what the evidence prefers, by
-  // `strength`), then where it goes when the scans that move with it (the weak side of the cheapest cut) take
-  // their twin placements, by the runner-up of the cut's link that loses least by it. As the links place them,
-  // not refined. Empty, and ambiguous false, otherwise.
+  // `strength`), then where the cheapest twin motion takes it with the scans on its side of the cut
+  // (twin_motion.h). As the links place them, not refined. Empty, and ambiguous false, otherwise.
   bool ambiguous = false;
   std::vector<Eigen::Matrix4d> candidate_poses;
   // How firmly its links in the refined project pin its translation, in the project's frame: their constraints
