@@ -3,7 +3,7 @@
 // bench/RESULTS.md (block "blind"), so a figure that holds only where it was tuned shows as such.
 //
 //   k4reg-bench-blind [--part tuning|held-out|all] [--suites NAME,...] [--seeds N] [--data-dir DIR]
-//                     [--cache-dir DIR] [--results-dir DIR] [--markdown FILE] [--list]
+//                     [--cache-dir DIR] [--results-dir DIR] [--markdown FILE] [--list] [--frame scanner|arbitrary]
 //
 // Every run is scored against the ground truth (RMSE over true correspondences, the paper's measure) and
 // counted as a success, a flagged miss (the result said `ambiguous`) or a confident miss (wrong, unflagged:
@@ -105,8 +105,10 @@ struct SceneSet {
 enum class Given { kNothing, kSigma, kSigmaAndOverlap };
 
 // The scans are cached on disk; the simulator gives every scan its own frame.
-Suite simulated_suite(const SceneSet& set, std::string part, Given given, const std::string& cache_dir) {
-  const std::string label = set.scene + (set.layout > 0 ? "-L" + std::to_string(set.layout) : "");
+Suite simulated_suite(const SceneSet& set, std::string part, Given given, const std::string& cache_dir,
+                      sim::ScanFrame frame) {
+  const std::string label = set.scene + (set.layout > 0 ? "-L" + std::to_string(set.layout) : "") +
+                            (frame == sim::ScanFrame::kArbitrary ? "-arb" : "");
   const char* suffix[] = {"-auto", "-sigma", "-given"};
   const std::string name = label + suffix[static_cast<int>(given)];
   const std::string what =
@@ -124,14 +126,17 @@ Suite simulated_suite(const SceneSet& set, std::string part, Given given, const 
           {}};
   for (auto [a, b] : set.stations) s.pairs.push_back(label + " " + std::to_string(a) + "->" + std::to_string(b));
   s.load = [=](std::size_t k, std::uint64_t) {
-    const CachedScan a = cached_simulated_scan(cache_dir, set.scene, set.stations.at(k).first, set.points, set.layout);
-    const CachedScan b = cached_simulated_scan(cache_dir, set.scene, set.stations.at(k).second, set.points, set.layout);
+    const CachedScan a =
+        cached_simulated_scan(cache_dir, set.scene, set.stations.at(k).first, set.points, set.layout, frame);
+    const CachedScan b =
+        cached_simulated_scan(cache_dir, set.scene, set.stations.at(k).second, set.points, set.layout, frame);
     return Pair{read_cloud(a.path), read_cloud(b.path), source_to_target_truth(a, b)};
   };
   return s;
 }
 
-std::vector<Suite> all_suites(const fs::path& data, const std::string& cache) {
+// frame: the simulated scans' (real sources are always moved by a random motion).
+std::vector<Suite> all_suites(const fs::path& data, const std::string& cache, sim::ScanFrame frame) {
   const fs::path bunny = data / "stanford-bunny-scans", kurt = data / "3dtk-kurt3d-scans";
   std::vector<Suite> suites;
   // Real objects: the bunny's pairs alternate between the parts (even log lines tune, odd ones are held out).
@@ -174,7 +179,7 @@ std::vector<Suite> all_suites(const fs::path& data, const std::string& cache) {
   };
   for (const auto& [set, part] : sets)
     for (Given given : {Given::kNothing, Given::kSigma, Given::kSigmaAndOverlap})
-      suites.push_back(simulated_suite(set, part, given, cache));
+      suites.push_back(simulated_suite(set, part, given, cache, frame));
   return suites;
 }
 
@@ -248,9 +253,16 @@ int main(int argc, char** argv) {
   SplitOptions o;
   o.seeds = 3;
   o.add_to(app, "blind");
+  std::string frame = "scanner";
+  app.add_option("--frame", frame,
+                 "the simulated scans' frames: scanner (scanner at the origin) or arbitrary (also shifted up to 30 m per "
+                 "axis; suites named -arb, results in blind-arbitrary-runs.csv and the RESULTS block blind-arbitrary)")
+      ->check(CLI::IsMember({"scanner", "arbitrary"}));
   CLI11_PARSE(app, argc, argv);
+  const bool arbitrary = frame == "arbitrary";
   try {
-    const auto suites = all_suites(o.data_dir, o.cache_dir);
+    const auto suites =
+        all_suites(o.data_dir, o.cache_dir, arbitrary ? k4reg::sim::ScanFrame::kArbitrary : k4reg::sim::ScanFrame::kScanner);
     if (o.list) {  // before the CSV is opened: listing must not empty the last run's results
       for (const Suite& s : suites)
         std::printf("%-22s %-9s %zu pairs  %s\n", s.name.c_str(), s.part.c_str(), s.pairs.size(), s.what.c_str());
@@ -258,7 +270,7 @@ int main(int argc, char** argv) {
     }
     std::vector<Run> runs;
     fs::create_directories(o.results_dir);
-    std::ofstream csv(fs::path(o.results_dir) / "blind-runs.csv");
+    std::ofstream csv(fs::path(o.results_dir) / (arbitrary ? "blind-arbitrary-runs.csv" : "blind-runs.csv"));
     csv << "part,suite,pair,seed,success,ambiguous,refused,rmse_m,seconds,min_scale_m_used,overlap_used,margin,note\n";
     for (const Suite& s : suites) {
       if (!o.selected(s.part, s.name)) continue;
@@ -278,7 +290,7 @@ int main(int argc, char** argv) {
     }
     const std::string table = report(suites, runs);
     std::printf("\n%s", table.c_str());
-    if (!o.markdown.empty()) replace_block(o.markdown, "blind", table);
+    if (!o.markdown.empty()) replace_block(o.markdown, arbitrary ? "blind-arbitrary" : "blind", table);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "k4reg-bench-blind: %s\n", e.what());
     return 1;

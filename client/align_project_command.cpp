@@ -1,7 +1,6 @@
 #include "align_project_command.h"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <iostream>
@@ -47,11 +46,11 @@ void run_align_project(AlignProjectOptions& o) {
       origins.push_back({file, scans > 1 ? static_cast<int>(k) : -1});
     }
   }
-  // Pair by pair on stderr when someone watches; stdout stays the result.
-  const bool watched = isatty(STDERR_FILENO);
+  // Pair by pair on stderr (a script that keeps the JSON on stdout still sees long work advance); stdout stays the
+  // result.
   const ProjectResult result = register_project(
       clouds, o.params, nullptr, {}, [&](const ProjectLink& link, std::size_t index, std::size_t pairs) {
-        if (!watched) return;
+        if (o.flags.quiet) return;
         std::cerr << pair_line(index, pairs, link.source, link.target, link.seconds,
                                link.verdict == "failed" ? link.reason : "")
                   << "\n";

@@ -16,6 +16,7 @@ void add_project_flags(CLI::App& command, ProjectFlags& flags, ProjectParams& pa
                        ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}).description(""))
                        ->capture_default_str();
   command.add_flag("--json", flags.json, "print the result as JSON");
+  command.add_flag("--quiet", flags.quiet, "no line per finished pair on stderr (stdout is the result either way)");
   command.add_option("--out-dir", flags.out_dir, "write NAME.pose.txt per registered scan and project.json here");
 }
 

@@ -12,12 +12,13 @@ namespace k4reg::cli {
 struct ProjectFlags {
   std::string pairs = "auto";  // auto, all, sequence, screened or a file of index pairs
   bool json = false;
+  bool quiet = false;  // no line per finished pair on stderr
   std::string out_dir;
   CLI::Option* reference = nullptr;  // count() = given
   CLI::Option* partners = nullptr;
 };
 
-// --reference, --pairs, --partners, --json, --out-dir.
+// --reference, --pairs, --partners, --json, --quiet, --out-dir.
 void add_project_flags(CLI::App& command, ProjectFlags& flags, ProjectParams& params);
 
 // --pairs into the parameters (reads the file of a list). Throws k4reg::Error for a bad list file.

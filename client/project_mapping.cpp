@@ -20,6 +20,7 @@ ProjectResult project_result_from_proto(const v1::ProjectResult& m) {
     scan.ambiguous = s.ambiguous();
     for (const v1::ScanPlacement& placement : s.candidate_poses())
       if (placement.pose_size() == 16) scan.candidate_poses.push_back(api::matrix_from_proto(placement.pose()));
+    scan.scanner_position = api::scanner_from_proto(s.scanner_position());
     r.scans.push_back(std::move(scan));
   }
   for (const v1::ProjectLink& l : m.links()) {

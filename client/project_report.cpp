@@ -34,7 +34,8 @@ nlohmann::json project_to_json(const ProjectResult& r, const std::vector<ScanOri
                           {"weakest_constraint", weakest_constraint(s.constraint)},
                           {"reason", s.reason},
                           {"ambiguous", s.ambiguous},
-                          {"candidate_poses", candidate_poses}});
+                          {"candidate_poses", candidate_poses},
+                          {"scanner_position", scanner_to_json(s.scanner_position)}});
   }
   j["links"] = nlohmann::json::array();
   for (const ProjectLink& l : r.links)
@@ -94,6 +95,7 @@ void print_project_table(std::ostream& out, const ProjectResult& r, const std::v
                        s.registered ? fmt::format("registered (strength {:.3f}, weakest constraint {:.2f})", s.strength,
                                                   weakest_constraint(s.constraint))
                                     : "NOT registered: " + s.reason);
+    out << fmt::format("  scanner: {}\n", scanner_to_text(s.scanner_position));
     if (s.registered) out << format_matrix4(s.pose);
     for (std::size_t k = 0; k < s.candidate_poses.size(); ++k)
       out << fmt::format("  candidate placement {}{}:\n", k + 1, k == 0 ? " (its links prefer it)" : " (the twin)")

@@ -1,7 +1,6 @@
 #include "register_project_command.h"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <iostream>
 #include <memory>
@@ -85,11 +84,10 @@ void run_register_project(const RegisterProjectOptions& o) {
       },
       [](std::uint64_t, std::uint64_t) {});
   // Queue position and each finished pair on stderr, as align-project prints them; stdout stays the result.
-  const bool watched = isatty(STDERR_FILENO);
   v1::RegisterProjectResponse response;
   for (v1::RegisterProjectEvent event; stream->Read(&event);) {
     if (event.has_result()) response = event.result();
-    if (!watched) continue;
+    if (o.flags.quiet) continue;
     if (event.has_queued()) std::cerr << fmt::format("queued: {} jobs ahead\n", event.queued().position());
     if (event.has_pair()) {
       const v1::PairEvent& pair = event.pair();

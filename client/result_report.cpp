@@ -20,6 +20,22 @@ nlohmann::json points_to_json(const std::vector<Eigen::Vector3d>& points) {
   return values;  // x, y, z of each point in turn
 }
 
+nlohmann::json scanner_to_json(const ScannerPosition& s) {
+  nlohmann::json point = nlohmann::json::array();
+  if (s.source != ScannerSource::kNone) point = {s.position_m.x(), s.position_m.y(), s.position_m.z()};
+  return {{"point_m", point},
+          {"source", to_string(s.source)},
+          {"fit", s.fit.share},
+          {"angular_step_rad", s.fit.step_rad},
+          {"reason", s.reason}};
+}
+
+std::string scanner_to_text(const ScannerPosition& s) {
+  if (s.source == ScannerSource::kNone) return "none: " + s.reason;
+  return fmt::format("{} ({:.3f}, {:.3f}, {:.3f}) m, fit {:.2f}", to_string(s.source), s.position_m.x(), s.position_m.y(),
+                     s.position_m.z(), s.fit.share);
+}
+
 nlohmann::json result_to_json(const RegistrationResult& r) {
   nlohmann::json j;
   j["transform"] = matrix_to_json(r.transform);
@@ -38,6 +54,8 @@ nlohmann::json result_to_json(const RegistrationResult& r) {
   j["ambiguity_reason"] = r.ambiguity_reason;
   j["well_supported"] = r.well_supported;
   j["free_space_used"] = r.free_space_used;
+  j["source_scanner_position"] = scanner_to_json(r.source_scanner);
+  j["target_scanner_position"] = scanner_to_json(r.target_scanner);
   j["min_scale_m_used"] = r.min_scale_m_used;
   j["overlap_used"] = r.overlap_used;
   j["axis_constraint"] = axis_constraint(r.constraint);
@@ -91,6 +109,8 @@ void print_result_table(std::ostream& out, const RegistrationResult& r) {
   out << fmt::format("{:<22}{}\n", "ambiguous", r.ambiguous ? "yes: " + r.ambiguity_reason : "no");
   out << fmt::format("{:<22}{}\n", "well supported", r.well_supported ? "yes" : "no");
   out << fmt::format("{:<22}{}\n", "free space used", r.free_space_used ? "yes" : "no (geometry alone)");
+  out << fmt::format("{:<22}{}\n", "source scanner", scanner_to_text(r.source_scanner));
+  out << fmt::format("{:<22}{}\n", "target scanner", scanner_to_text(r.target_scanner));
   out << fmt::format("{:<22}{}\n", "hypotheses", r.hypotheses.size());
   for (std::size_t k = 0; k < r.hypotheses.size(); ++k) {
     const Hypothesis& h = r.hypotheses[k];

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
+#include <string>
 
 #include "k4reg/registration/metrics.h"
 #include "k4reg/registration/registration.h"
@@ -15,6 +16,10 @@ nlohmann::json matrix_to_json(const Eigen::Matrix4d& m);
 
 // Points as 3 numbers each, one after the other (the API's layout).
 nlohmann::json points_to_json(const std::vector<Eigen::Vector3d>& points);
+
+// Where a scan's scanner stood: {"point_m", "source", "fit", "angular_step_rad", "reason"}, and one line.
+nlohmann::json scanner_to_json(const ScannerPosition& scanner);
+std::string scanner_to_text(const ScannerPosition& scanner);
 
 nlohmann::json result_to_json(const RegistrationResult& result);
 // Stage timings: [{"stage", "seconds"}], and as indented lines with their total.

@@ -41,6 +41,7 @@ void project_result_to_proto(const ProjectResult& r, const std::vector<std::stri
     out.set_reason(s.reason);
     out.set_ambiguous(s.ambiguous);
     for (const Eigen::Matrix4d& pose : s.candidate_poses) matrix_to_proto(pose, out.add_candidate_poses()->mutable_pose());
+    scanner_to_proto(s.scanner_position, out.mutable_scanner_position());
   }
   for (const ProjectLink& l : r.links) {
     v1::ProjectLink& out = *m->add_links();

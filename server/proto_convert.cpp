@@ -88,6 +88,16 @@ void preview_to_proto(const CloudPreview& preview, v1::Preview* m) {
   }
 }
 
+void scanner_to_proto(const ScannerPosition& scanner, v1::ScannerPosition* m) {
+  m->clear_point_m();
+  if (scanner.source != ScannerSource::kNone)
+    for (int axis = 0; axis < 3; ++axis) m->add_point_m(scanner.position_m(axis));
+  m->set_source(to_string(scanner.source));
+  m->set_fit(scanner.fit.share);
+  m->set_angular_step_rad(scanner.fit.step_rad);
+  m->set_reason(scanner.reason);
+}
+
 void result_to_proto(const RegistrationResult& r, v1::RegistrationResult* m) {
   matrix_to_proto(r.transform, m->mutable_transform());
   m->set_rmse_m(r.rmse_m);
@@ -105,6 +115,8 @@ void result_to_proto(const RegistrationResult& r, v1::RegistrationResult* m) {
   m->set_ambiguity_reason(r.ambiguity_reason);
   m->set_well_supported(r.well_supported);
   m->set_free_space_used(r.free_space_used);
+  scanner_to_proto(r.source_scanner, m->mutable_source_scanner_position());
+  scanner_to_proto(r.target_scanner, m->mutable_target_scanner_position());
   m->set_min_scale_m_used(r.min_scale_m_used);
   m->set_overlap_used(r.overlap_used);
   m->clear_hypotheses();

@@ -33,6 +33,7 @@ std::string cloud_digest(const v1::PairCloud& message);
 
 // Row-major 4x4 -> 16 repeated doubles.
 void matrix_to_proto(const Eigen::Matrix4d& matrix, google::protobuf::RepeatedField<double>* values);
+void scanner_to_proto(const ScannerPosition& scanner, v1::ScannerPosition* m);
 // A translation constraint (translation_constraint.h) into a message's constraint (9 numbers, row-major),
 // axis_constraint and weakest_constraint.
 template <typename Message>

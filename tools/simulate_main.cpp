@@ -1,5 +1,5 @@
 // k4reg-simulate: writes a simulated terrestrial laser scan of an analytic scene and its ground truth.
-//   k4reg-simulate --scene lab --station 0 --points 700000 --seed 1 --out scan.ply --gt scan.gt.txt
+//   k4reg-simulate --scene lab --station 0 --points 700000 --seed 1 [--frame arbitrary] --out scan.ply --gt scan.gt.txt
 //   k4reg-simulate --list [--layout 3]
 #include <CLI/CLI.hpp>
 
@@ -55,6 +55,12 @@ int main(int argc, char** argv) {
   const CLI::Option* noise_option = app.add_option("--noise-mm", noise_mm, "range noise standard deviation, mm (default: the scene's, see --list)");
   app.add_option("--max-range-m", params.max_range_m, "maximum range, m (0 = the scene's default)")->capture_default_str();
   app.add_option("--out", out_path, "scan file (.ply, .pcd, .xyz ...; format from the extension)");
+  std::string frame = "scanner";
+  app.add_option("--frame", frame,
+                 "the scan's frame: scanner (the scanner at the origin) or arbitrary (then shifted by up to 30 m per "
+                 "axis, as a scan exported in project coordinates)")
+      ->check(CLI::IsMember({"scanner", "arbitrary"}))
+      ->capture_default_str();
   app.add_option("--gt", gt_path, "ground-truth file: the 4x4 matrix mapping scan points into the scene frame");
   try {
     app.parse(argc, argv);
@@ -75,6 +81,7 @@ int main(int argc, char** argv) {
     if (points != 0 && points < 1000)
       k4reg::fail(k4reg::ErrorCode::kInvalidArgument, "--points must be at least 1000 (or 0), not " + std::to_string(points));
     params.points = static_cast<std::size_t>(points);
+    params.frame = frame == "arbitrary" ? k4reg::sim::ScanFrame::kArbitrary : k4reg::sim::ScanFrame::kScanner;
     if (noise_option->count() > 0) {
       if (!(noise_mm >= 0.0 && noise_mm <= 1000.0))
         k4reg::fail(k4reg::ErrorCode::kInvalidArgument, "--noise-mm must be between 0 and 1000, not " + std::to_string(noise_mm));

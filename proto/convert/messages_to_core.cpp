@@ -61,6 +61,15 @@ std::vector<Eigen::Vector3d> points_from_proto(const google::protobuf::RepeatedF
   return points;
 }
 
+ScannerPosition scanner_from_proto(const v1::ScannerPosition& m) {
+  ScannerPosition s;
+  s.source = scanner_source_named(m.source());
+  if (m.point_m_size() == 3) s.position_m = Eigen::Vector3d(m.point_m(0), m.point_m(1), m.point_m(2));
+  s.fit = {m.fit(), m.angular_step_rad()};
+  s.reason = m.reason();
+  return s;
+}
+
 RegistrationResult result_from_proto(const v1::RegistrationResult& m) {
   RegistrationResult r;
   r.transform = matrix_from_proto(m.transform());
@@ -79,6 +88,8 @@ RegistrationResult result_from_proto(const v1::RegistrationResult& m) {
   r.ambiguity_reason = m.ambiguity_reason();
   r.well_supported = m.well_supported();
   r.free_space_used = m.free_space_used();
+  r.source_scanner = scanner_from_proto(m.source_scanner_position());
+  r.target_scanner = scanner_from_proto(m.target_scanner_position());
   r.min_scale_m_used = m.min_scale_m_used();
   r.overlap_used = m.overlap_used();
   for (const v1::Hypothesis& h : m.hypotheses())

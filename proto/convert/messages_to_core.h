@@ -16,6 +16,7 @@ Eigen::Matrix4d matrix_from_proto(const google::protobuf::RepeatedField<double>&
 Eigen::Matrix3d constraint_from_proto(const google::protobuf::RepeatedField<double>& values);
 // x, y, z of each point in turn.
 std::vector<Eigen::Vector3d> points_from_proto(const google::protobuf::RepeatedField<double>& values);
+ScannerPosition scanner_from_proto(const v1::ScannerPosition& message);
 RegistrationResult result_from_proto(const v1::RegistrationResult& message);
 CloudPreview preview_from_proto(const v1::Preview& message);
 

@@ -45,6 +45,16 @@ TEST(AlignProjectCommand, JsonHasEveryScanAsGivenAndTheOutDirItsPoses) {
                           "verdict", "reason", "loops", "loops_closed", "loop_residual_m", "residual_m"})
     EXPECT_TRUE(j["links"][0].contains(key)) << key;
   EXPECT_EQ(j["loops_checked"], 1);
+  // Each scan says where its scanner stood: the bunny's range camera looked from outside the object, so none of
+  // these could be a terrestrial scanner's origin.
+  for (const auto& scan : j["scans"]) {
+    ASSERT_TRUE(scan.contains("scanner_position"));
+    for (const char* key : {"point_m", "source", "fit", "angular_step_rad", "reason"})
+      EXPECT_TRUE(scan["scanner_position"].contains(key)) << key;
+    EXPECT_NE(scan["scanner_position"]["source"], "origin");
+  }
+  // Long work shows itself on stderr even when stderr is no terminal (a script keeping stdout's JSON).
+  EXPECT_NE(run.err.find("pair 3/3"), std::string::npos) << run.err;
   for (const char* file : {"bun000.pose.txt", "bun045.pose.txt", "bun315.pose.txt", "project.json"})
     EXPECT_TRUE(fs::exists(dir.path() / "out" / file)) << file;
   std::ifstream saved(dir.path() / "out" / "project.json");
@@ -52,6 +62,13 @@ TEST(AlignProjectCommand, JsonHasEveryScanAsGivenAndTheOutDirItsPoses) {
 }
 
 // A multi-scan E57 counts as its scans, each registered in its own frame; --write-e57 gives them their poses.
+TEST(AlignProjectCommand, QuietPrintsNoPairLines) {
+  const CommandRun run =
+      k4reg(with_flags({"align-project", bunny("bun000.ply"), bunny("bun045.ply"), "--json", "--quiet"}));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err.find("pair "), std::string::npos) << run.err;
+}
+
 TEST(AlignProjectCommand, MultiScanE57InAndRegisteredE57Out) {
   TempDir dir;
   std::vector<E57Scan> scans;

@@ -168,7 +168,8 @@ TEST_F(HttpApi, OpenApiSchemasMatchTheProtoMessages) {
                                             "ProjectResult", "ProjectScan", "QueuedEvent", "RegisterProjectEvent",
                                             "RegisterProjectRequest", "RegisterProjectResponse", "RegisterRequest",
                                             "RegisterResponse", "RegisterStreamResponse", "RegistrationParams",
-                                            "RegistrationResult", "ScanPair", "ScanPlacement", "ServerInfo", "ServerTimings",
+                                            "RegistrationResult", "ScanPair", "ScanPlacement", "ScannerPosition", "ServerInfo",
+                                            "ServerTimings",
                                             "StageEvent", "StageTiming"}));
 }
 

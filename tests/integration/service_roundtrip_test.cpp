@@ -110,7 +110,8 @@ TEST_F(RoundTrip, StreamedUploadWithProgress) {
   std::vector<std::string> finished;
   for (const auto& e : events)
     if (e.has_stage() && e.stage().phase() == v1::StageEvent::PHASE_FINISHED) finished.push_back(e.stage().stage());
-  EXPECT_EQ(finished, (std::vector<std::string>{"load", "voxel_grid", "keypoints", "matching", "icp_setup", "symmetry_guard", "icp", "verdict", "polish"}));
+  EXPECT_EQ(finished, (std::vector<std::string>{"load", "voxel_grid", "scanner_position", "keypoints", "matching", "icp_setup",
+                                               "symmetry_guard", "icp", "verdict", "polish"}));
   EXPECT_EQ(server_.spooled_files(), 0u);
 }
 

@@ -119,7 +119,8 @@ TEST(Registration, ResultCarriesTheEvidence) {
   EXPECT_LE(r.ambiguity_margin, 1.0);
   std::vector<std::string> stages;
   for (const StageTiming& t : r.timings) stages.push_back(t.stage);
-  EXPECT_EQ(stages, (std::vector<std::string>{"voxel_grid", "keypoints", "matching", "icp_setup", "symmetry_guard", "icp", "verdict", "polish"}));
+  EXPECT_EQ(stages, (std::vector<std::string>{"voxel_grid", "scanner_position", "keypoints", "matching", "icp_setup",
+                                               "symmetry_guard", "icp", "verdict", "polish"}));
 
   params.icp = false;
   const RegistrationResult coarse = register_clouds(source, target, params);
@@ -209,7 +210,8 @@ TEST(Registration, ProgressReportsEveryStage) {
   register_clouds(source, target, bunny_params(0.9), nullptr, [&](const std::string& stage, double fraction) {
     if (fraction == 0.0) started.push_back(stage);
   });
-  EXPECT_EQ(started, (std::vector<std::string>{"voxel_grid", "keypoints", "matching", "icp_setup", "symmetry_guard", "icp", "verdict", "polish"}));
+  EXPECT_EQ(started, (std::vector<std::string>{"voxel_grid", "scanner_position", "keypoints", "matching", "icp_setup",
+                                               "symmetry_guard", "icp", "verdict", "polish"}));
 }
 
 PointCloud grid_cloud(int nx, int ny, int nz, float step) {

@@ -10,6 +10,7 @@
 
 #include "k4reg/registration/metrics.h"
 #include "k4reg/registration/registration.h"
+#include "pose_error.h"
 #include "sim/scanner.h"
 
 namespace k4reg {
@@ -85,11 +86,13 @@ struct SimulatedScans {
   Eigen::Matrix4d truth;
 };
 SimulatedScans simulate_pair(const std::string& scene_name, int layout, std::size_t points, std::uint64_t seed,
-                             int source_station = 0, int target_station = 1) {
+                             int source_station = 0, int target_station = 1,
+                             sim::ScanFrame frame = sim::ScanFrame::kScanner) {
   const sim::Scene scene = sim::make_scene(scene_name, layout);
   sim::ScanParams scan;
   scan.points = points;
   scan.seed = seed;
+  scan.frame = frame;
   SimulatedScans out{sim::simulate_scan(scene, source_station, scan), {}, {}};
   scan.seed = seed + 1;
   out.target = sim::simulate_scan(scene, target_station, scan);
@@ -115,6 +118,32 @@ TEST(SimulatedRegistration, MonumentSeenFromBothSidesIsNotFlipped) {
   // The flip is still among the hypotheses, clearly behind.
   ASSERT_GE(result.hypotheses.size(), 2u);
   EXPECT_GT(result.ambiguity_margin, 0.05);
+}
+
+// The lab's opposite corners with each scan in an arbitrary frame (rotated, and shifted up to 30 m): the files
+// say nothing of where the scanners stood, so their positions come from the scans' sampling, and the free space
+// breaks the half-turn symmetry as it does in the scanners' frames. Without it, geometry alone turned this pair
+// by 180 degrees with a margin that looked safe.
+TEST(SimulatedRegistration, OppositeCornersInArbitraryFramesAreJudgedFromEstimatedScanners) {
+  for (const std::uint64_t seed : {1, 2}) {
+    const SimulatedScans scans = simulate_pair("lab", 0, 200000, seed, 0, 2, sim::ScanFrame::kArbitrary);
+    ASSERT_GT(scans.source.cloud.origin_m.norm(), 1.0);
+    RegistrationParams params;
+    params.min_scale_m = 0.1;
+    params.overlap = 0.5;
+    params.seed = seed;
+    const RegistrationResult result = register_clouds(scans.source.cloud, scans.target.cloud, params);
+    EXPECT_TRUE(result.free_space_used) << "seed " << seed;
+    for (const auto& [scanner, scan] : {std::pair{&result.source_scanner, &scans.source},
+                                        std::pair{&result.target_scanner, &scans.target}}) {
+      EXPECT_EQ(scanner->source, ScannerSource::kEstimated) << scanner->reason;
+      const Eigen::Matrix4d to_file = scan->scan_to_scene.inverse();
+      const Eigen::Vector3d truth = to_file.topLeftCorner<3, 3>() * scan->station_m + to_file.topRightCorner<3, 1>();
+      EXPECT_LT((scanner->position_m - truth).norm(), 0.05) << "seed " << seed;
+    }
+    const double error_m = rms_error_m(scans.source.cloud, result.transform, scans.truth);
+    EXPECT_LT(error_m, 0.1) << "seed " << seed << (result.ambiguous ? " (flagged: " + result.ambiguity_reason + ")" : "");
+  }
 }
 
 // The corridor (a tuning layout of the blind protocol): doors every 4 m, and the whole layout half-turn

@@ -234,9 +234,16 @@ SimulatedScan simulate_scan(const Scene& scene, int station, const ScanParams& p
     std::vector<Eigen::Vector3f>().swap(points[c]);  // keeps the peak memory near one copy of the scan
     std::vector<float>().swap(intensity[c]);
   }
+  // An arbitrary frame moves the scanner off the origin: p_file = p_scan + shift (kept exact in origin_m).
+  Vector3d shift = Vector3d::Zero();
+  if (params.frame == ScanFrame::kArbitrary) {
+    RandomStream frame_rng(derive_key(scan_key, 3));
+    for (int axis = 0; axis < 3; ++axis) shift(axis) = kArbitraryShiftM * (2.0 * frame_rng.uniform() - 1.0);
+  }
+  scan.cloud.origin_m = shift;
   scan.scan_to_scene.setIdentity();
   scan.scan_to_scene.topLeftCorner<3, 3>() = scan_to_scene_rotation;
-  scan.scan_to_scene.topRightCorner<3, 1>() = origin;
+  scan.scan_to_scene.topRightCorner<3, 1>() = origin - scan_to_scene_rotation * shift;
   scan.station_m = origin;
   return scan;
 }

@@ -7,7 +7,9 @@
 //
 // The scan is returned in its own frame: the scene frame rotated by a random rotation (uniform on
 // SO(3) apart from excluding the ~1% within 10 deg of "up", so no scan keeps the scene's vertical)
-// and translated so the scanner is at the origin.
+// and translated so the scanner is at the origin (ScanFrame::kScanner), or then shifted by a random
+// translation of up to 30 m per axis (kArbitrary: a scan exported in project coordinates, cropped and
+// re-saved or moved by another tool, whose file says nothing of where its scanner stood).
 #pragma once
 
 #include <Eigen/Core>
@@ -20,6 +22,8 @@
 
 namespace k4reg::sim {
 
+enum class ScanFrame { kScanner, kArbitrary };
+
 struct ScanParams {
   // Points wanted. The angular step is chosen so that rays x (hit fraction of a coarse pilot scan from
   // the same station) = points, so the result lands within a few per cent of this.
@@ -27,7 +31,10 @@ struct ScanParams {
   std::uint64_t seed = 1;                // reproduces the scan bit for bit, for any thread count
   std::optional<double> noise_m;         // range noise standard deviation; unset = the scene's default
   double max_range_m = 0;                // 0 = the scene's default
+  ScanFrame frame = ScanFrame::kScanner;  // the same points either way, only the frame differs
 };
+
+constexpr double kArbitraryShiftM = 30.0;  // kArbitrary: the translation's reach per axis
 
 struct SimulatedScan {
   k4reg::PointCloud cloud;          // scan frame, with intensity in [0, 1] if the scene records it

@@ -511,7 +511,11 @@ PointCloud read_e57_bytes(std::string_view data, const std::string& name, const 
     all_have_intensity &= points.size() == first_point || (scan.intensity >= 0 && varies);
   }
   if (!all_have_intensity) intensity.clear();
-  return io_detail::finish_cloud(std::move(points), std::move(intensity), name);
+  PointCloud cloud = io_detail::finish_cloud(std::move(points), std::move(intensity), name);
+  // A scan's pose places its own frame, the scanner's, in the file's; merged scans have no one scanner.
+  if (scans.size() == 1)
+    cloud.scanner_m = options.apply_pose ? Eigen::Vector3d(scans.front().pose.translation()) : Eigen::Vector3d::Zero();
+  return cloud;
 }
 
 std::size_t count_e57_scans(std::string_view data, const std::string& name) { return open_e57(data, name)->entries.size(); }

@@ -125,6 +125,7 @@ PointCloud read_ptx_bytes(std::string_view data, const std::string& name, const 
   std::vector<float> intensity;
   std::vector<std::string_view> tokens;
   std::size_t scans = 0, selected_scans = 0, scans_with_intensity = 0;
+  Eigen::Vector3d scanner_m = Eigen::Vector3d::Zero();  // the last selected scan's
   for (; skip_blank_lines(lines); ++scans) {
     ScanHeader h;
     const HeaderProblem problem = parse_header(lines, h);
@@ -152,6 +153,7 @@ PointCloud read_ptx_bytes(std::string_view data, const std::string& name, const 
     const Eigen::Matrix4d to_file = options.apply_pose ? h.scanner_to_file : Eigen::Matrix4d::Identity();
     const Eigen::Matrix3d rotation = to_file.topLeftCorner<3, 3>();
     const Eigen::Vector3d translation = to_file.topRightCorner<3, 1>();
+    if (selected) scanner_m = translation;
     for (std::uint64_t cell = 0; cell < cells; ++cell) {
       if (!lines.next(line))
         fail_io(ErrorCode::kInvalidArgument, name,
@@ -201,7 +203,9 @@ PointCloud read_ptx_bytes(std::string_view data, const std::string& name, const 
             "scan index " + std::to_string(*options.scan_index) + " does not exist: the file has " +
                 std::to_string(scans) + " scan" + (scans == 1 ? "" : "s") + " (0-based)");
   if (scans_with_intensity != selected_scans) intensity.clear();
-  return io_detail::finish_cloud(std::move(points), std::move(intensity), name);
+  PointCloud cloud = io_detail::finish_cloud(std::move(points), std::move(intensity), name);
+  if (selected_scans == 1) cloud.scanner_m = scanner_m;  // merged scans have no one scanner
+  return cloud;
 }
 
 std::size_t count_ptx_scans(std::string_view data, const std::string& name) {

@@ -524,6 +524,8 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     break;
   }
   r.scans_registered = std::count_if(r.scans.begin(), r.scans.end(), [](const ProjectScan& s) { return s.registered; });
+  // As the pairs judged them where they ran here; else (pairs run on peers) what is known without a search.
+  for (std::size_t i = 0; i < r.scans.size(); ++i) r.scans[i].scanner_position = prepared[i].scanner_known(&budget);
   if (progress) progress("refinement", 1.0);
   add_timing(r.timings, "refinement", seconds_since(start));
   return r;

@@ -150,12 +150,4 @@ FreeSpaceImage::Seen FreeSpaceImage::classify(const Eigen::Vector3f& q) const {
   return at.range <= nearest + margin_ ? Seen::kSurface : Seen::kOccluded;
 }
 
-double FreeSpaceImage::median_range_m(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& scanner_m) {
-  if (points.empty()) return 0.0;
-  std::vector<float> ranges(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) ranges[i] = (points[i] - scanner_m).norm();
-  std::nth_element(ranges.begin(), ranges.begin() + ranges.size() / 2, ranges.end());
-  return ranges[ranges.size() / 2];
-}
-
 }  // namespace k4reg

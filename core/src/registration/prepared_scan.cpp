@@ -1,9 +1,11 @@
 #include "k4reg/registration/prepared_scan.h"
 
 #include "k4reg/registration/pose_score.h"
+#include "k4reg/registration/scanner_sampling.h"
 #include "k4reg/registration/single_view.h"
 #include "k4reg/util/error.h"
 
+#include <atomic>
 #include <map>
 #include <mutex>
 #include <tuple>
@@ -16,6 +18,14 @@ namespace {
 template <typename Key, typename Value>
 class Entries {
  public:
+  // The value made for key, or null where none has been made (yet).
+  const Value* made(const Key& key) {
+    const std::lock_guard lock(mutex_);
+    const auto found = entries_.find(key);
+    return found == entries_.end() || !found->second->ready.load(std::memory_order_acquire) ? nullptr
+                                                                                            : found->second->value.get();
+  }
+
   template <typename Make>
   Value& get(const Key& key, const Make& make) {
     Entry* entry;
@@ -25,7 +35,10 @@ class Entries {
       if (!slot) slot = std::make_unique<Entry>();
       entry = slot.get();
     }
-    std::call_once(entry->once, [&] { entry->value = std::make_unique<Value>(make()); });
+    std::call_once(entry->once, [&] {
+      entry->value = std::make_unique<Value>(make());
+      entry->ready.store(true, std::memory_order_release);
+    });
     return *entry->value;
   }
 
@@ -33,6 +46,7 @@ class Entries {
   struct Entry {
     std::once_flag once;
     std::unique_ptr<Value> value;
+    std::atomic<bool> ready{false};  // value made (made() reads it without the once_flag)
   };
   std::mutex mutex_;
   std::map<Key, std::unique_ptr<Entry>> entries_;
@@ -51,6 +65,8 @@ struct PreparedScan::Cache {
   Entries<double, VoxelizedCloud> voxels;
   Entries<std::tuple<double, int, double>, Pyramid> pyramids;  // sigma, stages, distance factor
   Entries<std::tuple<double, int, bool, int, int, double>, ScanKeypoints> keypoints;  // sigma, signal, DoG
+  Entries<int, NeighbourAngles> neighbour_angles;
+  Entries<int, ScannerPosition> scanner, declared_scanner;
   Entries<double, FreeSpaceImage> free_space;
   Entries<double, std::optional<Eigen::Vector3f>> view_direction;       // sigma
   Entries<std::pair<double, double>, FreeSpaceImage> view_free_space;  // sigma, margin
@@ -94,9 +110,42 @@ const ScanKeypoints& PreparedScan::keypoints(double sigma_m, KeypointSignal sign
   });
 }
 
+namespace {
+constexpr std::size_t kNeighbourPairs = 4096;  // enough to judge a position to a millimetre on simulated stations
+}  // namespace
+
+const ScannerPosition& PreparedScan::scanner(const CancellationToken* cancel) const {
+  return cache_->scanner.get(0, [&] {
+    const NeighbourAngles& angles = cache_->neighbour_angles.get(
+        0, [&] { return NeighbourAngles(cloud_->points, sampling().spacing_m, kNeighbourPairs, cancel); });
+    return locate_scanner(*cloud_, angles, cancel);
+  });
+}
+
+const ScannerPosition& PreparedScan::declared_scanner(const CancellationToken* cancel) const {
+  return cache_->declared_scanner.get(0, [&] {
+    const NeighbourAngles& angles = cache_->neighbour_angles.get(
+        0, [&] { return NeighbourAngles(cloud_->points, sampling().spacing_m, kNeighbourPairs, cancel); });
+    return check_declared_scanner(*cloud_, angles);
+  });
+}
+
+const ScannerPosition& PreparedScan::scanner_known(const CancellationToken* cancel) const {
+  const ScannerPosition* located = cache_->scanner.made(0);
+  return located ? *located : declared_scanner(cancel);
+}
+
+Eigen::Vector3f PreparedScan::scanner_local(const CancellationToken* cancel) const {
+  return (scanner(cancel).position_m - cloud_->origin_m).cast<float>();
+}
+
+bool PreparedScan::scanner_surrounded(const CancellationToken* cancel) const {
+  return scanner(cancel).source != ScannerSource::kNone && surrounded_by(cloud_->points, scanner_local(cancel));
+}
+
 const FreeSpaceImage& PreparedScan::free_space(double margin_m) const {
-  return cache_->free_space.get(
-      margin_m, [&] { return FreeSpaceImage(cloud_->points, Viewpoint::at(scanner_position(*cloud_)), margin_m); });
+  return cache_->free_space.get(margin_m,
+                                [&] { return FreeSpaceImage(cloud_->points, Viewpoint::at(scanner_local()), margin_m); });
 }
 
 const std::optional<Eigen::Vector3f>& PreparedScan::view_direction(double sigma_m, const CancellationToken* cancel) const {

@@ -100,27 +100,21 @@ void check_geometry(const std::vector<Eigen::Vector3f>& points, double scale_m, 
     fail(ErrorCode::kInvalidArgument, std::string(name) + " cloud is degenerate: all points lie on a plane");
 }
 
-// Whether p lies inside the bounding box of the points.
-bool inside_bounds(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& p) {
-  Eigen::Vector3f low = Eigen::Vector3f::Constant(std::numeric_limits<float>::max()), high = -low;
-  for (const Eigen::Vector3f& q : points) {
-    low = low.cwiseMin(q);
-    high = high.cwiseMax(q);
-  }
-  return (p.array() >= low.array()).all() && (p.array() <= high.array()).all();
-}
-
-bool use_free_space(FreeSpaceCheck check, const VoxelizedCloud& source, const VoxelizedCloud& target) {
-  if (check != FreeSpaceCheck::kAuto) return check == FreeSpaceCheck::kOn;
-  // A terrestrial scan in its scanner's frame surrounds the origin at metres. Object scans (whose origin
-  // may sit inside the object) and georeferenced exports (whose origin is a map datum kilometres away)
-  // say nothing about where the scanner stood.
-  constexpr double kMinScannerRange_m = 1.0;
-  auto scanner_known = [&](const PointCloud& cloud) {
-    return inside_bounds(cloud.points, scanner_position(cloud)) &&
-           FreeSpaceImage::median_range_m(cloud.points, scanner_position(cloud)) >= kMinScannerRange_m;
-  };
-  return scanner_known(source.cloud) && scanner_known(target.cloud);
+// Whose free space judges the pair (params.free_space): kOn the scanners' (from the positions known, else the frames'
+// origins), kOff none. kAuto: the scanners' where the sampling confirms both declared positions (scans in scanner
+// coordinates, or with their poses: no search); else the cameras' where both are single views of an object; else
+// the scanners' where both positions are found from the sampling and could be terrestrial scanners'
+// (scanner_position.h); else none.
+enum class FreeSpaceFrom { kNothing, kScanners, kCameras };
+FreeSpaceFrom free_space_from(FreeSpaceCheck check, const PreparedScan& source, const PreparedScan& target, double sigma,
+                              const CancellationToken* cancel) {
+  if (check != FreeSpaceCheck::kAuto) return check == FreeSpaceCheck::kOn ? FreeSpaceFrom::kScanners : FreeSpaceFrom::kNothing;
+  if (source.declared_scanner(cancel).source != ScannerSource::kNone &&
+      target.declared_scanner(cancel).source != ScannerSource::kNone)
+    return FreeSpaceFrom::kScanners;
+  if (source.view_direction(sigma, cancel) && target.view_direction(sigma, cancel)) return FreeSpaceFrom::kCameras;
+  return source.scanner_surrounded(cancel) && target.scanner_surrounded(cancel) ? FreeSpaceFrom::kScanners
+                                                                                : FreeSpaceFrom::kNothing;
 }
 
 // The voxel spacing at which a cloud keeps about `points` voxels (the paper's plain-4PCS baseline).
@@ -358,20 +352,21 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   const double delta = !plain ? 2.0 * sigma : timer.run("plain_grid", [&] {
     return params.plain_voxel_m > 0 ? params.plain_voxel_m : spacing_for_count(source_voxels.cloud, 4 * sigma, 2000);
   });
-  // Free space (free_space.h): the scanners' where both scans say where theirs stood, else the cameras' where
-  // both are single views of an object. Raw points fill every cell.
+  // Free space (free_space.h), seen from the scanners or along the cameras (free_space_from). Raw points fill
+  // every cell.
   const double margin_m = 3.0 * delta;
   ScanViews views;
-  if (use_free_space(params.free_space, source_voxels, target_voxels)) {
-    views = {&target_scan.free_space(margin_m), Viewpoint::at(scanner_position(source)),
-             Viewpoint::at(scanner_position(target))};
-  } else if (params.free_space == FreeSpaceCheck::kAuto) {
-    const std::optional<Eigen::Vector3f>& source_camera = source_scan.view_direction(sigma, cancel);
-    const std::optional<Eigen::Vector3f>& target_camera = target_scan.view_direction(sigma, cancel);
-    if (source_camera && target_camera)
-      views = {&target_scan.view_free_space(sigma, margin_m, cancel), Viewpoint::along(*source_camera),
-               Viewpoint::along(*target_camera)};
-  }
+  const FreeSpaceFrom from = timer.run("scanner_position", [&] {
+    return free_space_from(params.free_space, source_scan, target_scan, sigma, cancel);
+  });
+  if (from == FreeSpaceFrom::kScanners)
+    views = {&target_scan.free_space(margin_m), Viewpoint::at(source_scan.scanner_local(cancel)),
+             Viewpoint::at(target_scan.scanner_local(cancel))};
+  if (from == FreeSpaceFrom::kCameras)
+    views = {&target_scan.view_free_space(sigma, margin_m, cancel), Viewpoint::along(*source_scan.view_direction(sigma, cancel)),
+             Viewpoint::along(*target_scan.view_direction(sigma, cancel))};
+  result.source_scanner = source_scan.scanner_known(cancel);
+  result.target_scanner = target_scan.scanner_known(cancel);
   result.free_space_used = views.target_free_space != nullptr;
   const ScanViews* seen = result.free_space_used ? &views : nullptr;  // what the guard and the scorer weigh
 

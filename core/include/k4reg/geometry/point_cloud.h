@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 namespace k4reg {
@@ -14,15 +15,14 @@ struct PointCloud {
   // Either empty (no intensity in the source) or one value per point, in the file's own units.
   std::vector<float> intensity;
   Eigen::Vector3d origin_m = Eigen::Vector3d::Zero();
+  // Where the scanner stood, in the file's frame, where the file says it (one E57 scan's pose, one PTX scan's
+  // scanner registration); unset otherwise (see scanner_position.h).
+  std::optional<Eigen::Vector3d> scanner_m;
 
   std::size_t size() const { return points.size(); }
   bool empty() const { return points.empty(); }
   bool has_intensity() const { return !intensity.empty() && intensity.size() == points.size(); }
 };
-
-// Where the scanner stood, for a scan in its scanner's frame: the file frame's origin, i.e. -origin_m in the
-// cloud's local frame.
-inline Eigen::Vector3f scanner_position(const PointCloud& cloud) { return (-cloud.origin_m).cast<float>(); }
 
 // Builds a cloud from double-precision coordinates: picks a local origin (rounded centre of the
 // bounding box) and stores float offsets from it. Throws kInvalidArgument on NaN/Inf and on coordinates

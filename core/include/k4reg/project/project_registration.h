@@ -93,6 +93,8 @@ struct ProjectScan {
   // How firmly its links in the refined project pin its translation, in the project's frame: their constraints
   // added and scaled to trace 3 (translation_constraint.h); zero when not registered or linked.
   Eigen::Matrix3d constraint = Eigen::Matrix3d::Zero();
+  // Where its scanner stood, in its file's frame, and where that comes from (scanner_position.h).
+  ScannerPosition scanner_position;
 };
 
 struct ProjectResult {

@@ -59,10 +59,6 @@ class FreeSpaceImage {
   Seen classify(const Eigen::Vector3f& q) const;
   const Viewpoint& viewpoint() const { return viewpoint_; }
 
-  // Median distance of the points from the scanner: small values mean the origin is not a scanner
-  // position (e.g. object scans whose frame origin is inside the object).
-  static double median_range_m(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& scanner_m);
-
  private:
   struct Located {
     int cell = -1;  // -1: outside the image

@@ -21,6 +21,7 @@
 #include "k4reg/registration/dog_keypoints.h"
 #include "k4reg/registration/free_space.h"
 #include "k4reg/registration/icp.h"
+#include "k4reg/registration/scanner_position.h"
 #include "k4reg/registration/surface_signal.h"
 #include "k4reg/util/cancellation.h"
 
@@ -49,7 +50,19 @@ class PreparedScan {
   // use_intensity: whether the pair uses intensity (both scans have it); see make_surface_signal.
   const ScanKeypoints& keypoints(double sigma_m, KeypointSignal signal, bool use_intensity, const DogParams& dog,
                                  const CancellationToken* cancel) const;
-  // The raw points seen from the scanner (the file frame's origin), with this margin.
+  // Where its scanner stood (locate_scanner, scanner_position.h): from the file, the frame's origin or the sampling.
+  const ScannerPosition& scanner(const CancellationToken* cancel = nullptr) const;
+  // Only whether the declared position (file or origin) is confirmed by the sampling, without searching elsewhere:
+  // none otherwise. Cheap: the sampled neighbours and one judgement.
+  const ScannerPosition& declared_scanner(const CancellationToken* cancel = nullptr) const;
+  // scanner() where it has been asked for, else declared_scanner(): what is known without a search.
+  const ScannerPosition& scanner_known(const CancellationToken* cancel = nullptr) const;
+  // Whether scanner() is known and could be a terrestrial scanner's position (surrounded_by): what the scanner
+  // free-space evidence needs.
+  bool scanner_surrounded(const CancellationToken* cancel = nullptr) const;
+  // scanner()'s position in the cloud's local frame (the frame's origin where none is known).
+  Eigen::Vector3f scanner_local(const CancellationToken* cancel = nullptr) const;
+  // The raw points seen from scanner_local(), with this margin.
   const FreeSpaceImage& free_space(double margin_m) const;
   // Where the scan is one range camera's view of an object (single_view.h, judged on normals at sigma_m's
   // voxels): the direction toward the camera; else nothing.

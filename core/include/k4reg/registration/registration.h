@@ -13,6 +13,7 @@
 
 #include "k4reg/util/cancellation.h"
 #include "k4reg/geometry/point_cloud.h"
+#include "k4reg/registration/scanner_position.h"
 
 namespace k4reg {
 
@@ -28,9 +29,10 @@ enum class KeypointSignal {
 };
 
 enum class FreeSpaceCheck {
-  kAuto,  // on when both scans look like terrestrial scans taken from (and around) their frame's origin, or
-          // like single views of an object by a range camera (single_view.h: seen along their viewing direction)
-  kOn,    // from the frames' origins
+  kAuto,  // on when both scans have a terrestrial scanner position (scanner_position.h: from the file, the frame's
+          // origin or the scan's sampling), or are single views of an object by a range camera (single_view.h: seen
+          // along their viewing direction)
+  kOn,    // from the scanner positions known, else the frames' origins
   kOff,
 };
 
@@ -120,6 +122,8 @@ struct RegistrationResult {
   std::size_t source_keypoints = 0, target_keypoints = 0;
   std::string signal;           // "intensity" or "geometric" (or "voxels" for plain 4PCS)
   bool free_space_used = false;
+  // Where each scan's scanner stood (file frames), and where that comes from: what the free space is seen from.
+  ScannerPosition source_scanner, target_scanner;
   double min_scale_m_used = 0.0;  // the scale the result was found at
   double overlap_used = 0.0;      // the overlap whose bases found it
   // (best - runner-up) / best, on the evidence that decided (fine geometry and intensity); small = ambiguous.
