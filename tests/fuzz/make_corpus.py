@@ -231,6 +231,23 @@ def request_seeds(ply, text):
     return seeds, json_seeds
 
 
+def health_request_seeds():
+    """Heads as probes, curl and odd clients send them to the health listener (fuzz_health_request)."""
+    return {
+        "kube_probe.txt": b"GET /healthz HTTP/1.1\r\nHost: 10.0.0.7:8081\r\nUser-Agent: kube-probe/1.29\r\n"
+                          b"Accept: */*\r\nConnection: close\r\n\r\n",
+        "readyz_query.txt": b"GET /readyz?verbose=1 HTTP/1.1\r\nHost: localhost\r\nx-request-id: probe-1\r\n\r\n",
+        "head_http10.txt": b"HEAD /healthz HTTP/1.0\r\n\r\n",
+        "empty_values.txt": b"GET /healthz HTTP/1.1\r\nX-Empty:\r\nX-Blank: \t \r\n\r\n",
+        "bare_lf.txt": b"GET /healthz HTTP/1.1\nHost: x\n\n",
+        "post_body.txt": b"POST /healthz HTTP/1.1\r\nContent-Length: 4\r\n\r\nbody",
+        "odd_method.txt": b"FOO /healthz HTTP/1.1\r\n\r\n",
+        "http2_preface.txt": b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n",
+        "unfinished.txt": b"GET /healthz HTTP/1.1\r\nHost: x\r\n",
+        "folded.txt": b"GET /healthz HTTP/1.1\r\nX-A: 1\r\n  continued\r\n\r\n",
+    }
+
+
 def write(target, seeds):
     folder = os.path.join(CORPUS, target)  # inputs that once were findings (regress_*) stay
     os.makedirs(folder, exist_ok=True)
@@ -277,6 +294,7 @@ def main():
     grpc_seeds, json_seeds = request_seeds(ply, text)
     write("fuzz_grpc_request", grpc_seeds)
     write("fuzz_http_request", json_seeds)
+    write("fuzz_health_request", health_request_seeds())
     return 0
 
 
