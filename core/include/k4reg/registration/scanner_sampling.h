@@ -36,9 +36,11 @@ class NeighbourAngles {
   // Per sampled point, the log of the larger of two neighbour angles seen from scanner_m, the nearest and the
   // nearest in another direction (the step, from a scanner); NaN where that cannot be told.
   std::vector<double> log_steps(const Eigen::Vector3d& scanner_m) const;
-  // The centroids of the 2 and 10 % of the points closest to their nearest neighbour: the points nearest a scanner
-  // are the densest (the floor around its foot, the ceiling above it), so these lie near it or on its vertical.
-  std::vector<Eigen::Vector3f> densest_centroids() const;
+  // Where a scanner may stand, from the densest points (those closest to their nearest neighbour: 2 and 10 % of
+  // them): a scanner's nearest returns are the ground around the foot of its tripod, a ring about its vertical,
+  // so it stands on the ring's axis, its height a few times the ring's radius. The centroids and points up that
+  // axis at 0.5-3 radii, both ways.
+  std::vector<Eigen::Vector3f> near_scanner_candidates() const;
   const std::vector<Eigen::Vector3f>& points() const { return points_; }
   // Every k-th of the points with their neighbours, about `pairs` of them.
   NeighbourAngles thinned(std::size_t pairs) const;
