@@ -296,10 +296,10 @@ ScannerEstimate estimate_scanner_position(const NeighbourAngles& angles, const C
   }
   const Eigen::Vector3f extent = (high - low).cwiseMax(1e-3f);
 
-  // Candidates: the centres of a grid over the box (the best few by the share of a wide window), and the centroids
-  // of the densest neighbour pairs (the points nearest a scanner are the densest: the floor around its foot, the
-  // ceiling above it). Each is refined under a loss whose scale narrows from a wide basin to the step's precision;
-  // the one with the largest share of neighbours one step apart wins.
+  // Candidates: the centres of a grid over the box and the points up the axis of the densest points' ring
+  // (near_scanner_candidates), the best few of each by the share of a wide window. Each is refined under a loss
+  // whose scale narrows from a wide basin to the step's precision; the one with the largest share of neighbours one
+  // step apart wins.
   struct Candidate {
     Eigen::Vector3f at;
     SamplingFit fit;
