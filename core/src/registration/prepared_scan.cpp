@@ -112,21 +112,26 @@ const ScanKeypoints& PreparedScan::keypoints(double sigma_m, KeypointSignal sign
 
 namespace {
 constexpr std::size_t kNeighbourPairs = 4096;  // enough to judge a position to a millimetre on simulated stations
+
+// The scan's sampled neighbours, made once for both judgements of its scanner position.
+const NeighbourAngles& neighbour_angles(Entries<int, NeighbourAngles>& entries, const PointCloud& cloud,
+                                        double spacing_m, const CancellationToken* cancel) {
+  return entries.get(0, [&] { return NeighbourAngles(cloud.points, spacing_m, kNeighbourPairs, cancel); });
+}
 }  // namespace
 
 const ScannerPosition& PreparedScan::scanner(const CancellationToken* cancel) const {
   return cache_->scanner.get(0, [&] {
-    const NeighbourAngles& angles = cache_->neighbour_angles.get(
-        0, [&] { return NeighbourAngles(cloud_->points, sampling().spacing_m, kNeighbourPairs, cancel); });
-    return locate_scanner(*cloud_, angles, cancel);
+    // locate_scanner's first step is declared_scanner's: a confirmed declared position is taken as judged there.
+    const ScannerPosition& declared = declared_scanner(cancel);
+    if (declared.source != ScannerSource::kNone) return declared;
+    return locate_scanner(*cloud_, neighbour_angles(cache_->neighbour_angles, *cloud_, sampling().spacing_m, cancel), cancel);
   });
 }
 
 const ScannerPosition& PreparedScan::declared_scanner(const CancellationToken* cancel) const {
   return cache_->declared_scanner.get(0, [&] {
-    const NeighbourAngles& angles = cache_->neighbour_angles.get(
-        0, [&] { return NeighbourAngles(cloud_->points, sampling().spacing_m, kNeighbourPairs, cancel); });
-    return check_declared_scanner(*cloud_, angles);
+    return check_declared_scanner(*cloud_, neighbour_angles(cache_->neighbour_angles, *cloud_, sampling().spacing_m, cancel));
   });
 }
 
