@@ -4,6 +4,7 @@
 //
 //   k4reg-bench-blind [--part tuning|held-out|all] [--suites NAME,...] [--seeds N] [--data-dir DIR]
 //                     [--cache-dir DIR] [--results-dir DIR] [--markdown FILE] [--list] [--frame scanner|arbitrary]
+//                     [--free-space auto|off]
 //
 // Every run is scored against the ground truth (RMSE over true correspondences, the paper's measure) and
 // counted as a success, a flagged miss (the result said `ambiguous`) or a confident miss (wrong, unflagged:
@@ -183,7 +184,7 @@ std::vector<Suite> all_suites(const fs::path& data, const std::string& cache, si
   return suites;
 }
 
-Run run_one(const Suite& suite, std::size_t k, std::uint64_t seed) {
+Run run_one(const Suite& suite, std::size_t k, std::uint64_t seed, FreeSpaceCheck free_space) {
   Run run;
   run.suite = suite.name, run.part = suite.part, run.pair = suite.pairs[k], run.seed = seed;
   const Pair pair = suite.load(k, seed);
@@ -191,6 +192,7 @@ Run run_one(const Suite& suite, std::size_t k, std::uint64_t seed) {
   params.min_scale_m = suite.min_scale_m;
   params.overlap = suite.overlap;
   params.seed = seed;
+  params.free_space = free_space;
   const auto start = Clock::now();
   try {
     const RegistrationResult r = register_clouds(pair.source, pair.target, params);
@@ -204,8 +206,8 @@ Run run_one(const Suite& suite, std::size_t k, std::uint64_t seed) {
     run.note = r.ambiguity_reason;
     for (std::size_t h = 0; h < std::min<std::size_t>(3, r.hypotheses.size()); ++h) {
       char scores[128];
-      std::snprintf(scores, sizeof scores, " [#%zu cloud %.2f refined %.2f err %.3g]", h + 1,
-                    r.hypotheses[h].cloud_score, r.hypotheses[h].refined_score,
+      std::snprintf(scores, sizeof scores, " [#%zu cloud %.2f refined %.2f surface %.2f err %.3g]", h + 1,
+                    r.hypotheses[h].cloud_score, r.hypotheses[h].refined_score, r.hypotheses[h].surface_agreement,
                     file_frame_error(pair.source, r.hypotheses[h].transform, pair.truth).rmse_m);
       run.note += scores;
     }
@@ -258,8 +260,15 @@ int main(int argc, char** argv) {
                  "the simulated scans' frames: scanner (scanner at the origin) or arbitrary (also shifted up to 30 m per "
                  "axis; suites named -arb, results in blind-arbitrary-runs.csv and the RESULTS block blind-arbitrary)")
       ->check(CLI::IsMember({"scanner", "arbitrary"}));
+  std::string free_space = "auto";
+  app.add_option("--free-space", free_space,
+                 "auto (as a user gets it) or off (geometry alone: results in blind[-arbitrary]-geometry-runs.csv and "
+                 "the RESULTS block blind[-arbitrary]-geometry)")
+      ->check(CLI::IsMember({"auto", "off"}));
   CLI11_PARSE(app, argc, argv);
   const bool arbitrary = frame == "arbitrary";
+  const bool geometry_only = free_space == "off";
+  const std::string stem = std::string(arbitrary ? "blind-arbitrary" : "blind") + (geometry_only ? "-geometry" : "");
   try {
     const auto suites =
         all_suites(o.data_dir, o.cache_dir, arbitrary ? k4reg::sim::ScanFrame::kArbitrary : k4reg::sim::ScanFrame::kScanner);
@@ -270,13 +279,13 @@ int main(int argc, char** argv) {
     }
     std::vector<Run> runs;
     fs::create_directories(o.results_dir);
-    std::ofstream csv(fs::path(o.results_dir) / (arbitrary ? "blind-arbitrary-runs.csv" : "blind-runs.csv"));
+    std::ofstream csv(fs::path(o.results_dir) / (stem + "-runs.csv"));
     csv << "part,suite,pair,seed,success,ambiguous,refused,rmse_m,seconds,min_scale_m_used,overlap_used,margin,note\n";
     for (const Suite& s : suites) {
       if (!o.selected(s.part, s.name)) continue;
       for (std::size_t k = 0; k < s.pairs.size(); ++k)
         for (int seed = 1; seed <= o.seeds; ++seed) {
-          const Run r = run_one(s, k, seed);
+          const Run r = run_one(s, k, seed, geometry_only ? k4reg::FreeSpaceCheck::kOff : k4reg::FreeSpaceCheck::kAuto);
           runs.push_back(r);
           std::printf("%-9s %-20s %-28s seed %d: %s rmse %.4g (%.2f s, sigma %.3g, overlap %.2f, margin %.3f) %s\n",
                       r.part.c_str(), r.suite.c_str(), r.pair.c_str(), seed,
@@ -290,7 +299,7 @@ int main(int argc, char** argv) {
     }
     const std::string table = report(suites, runs);
     std::printf("\n%s", table.c_str());
-    if (!o.markdown.empty()) replace_block(o.markdown, arbitrary ? "blind-arbitrary" : "blind", table);
+    if (!o.markdown.empty()) replace_block(o.markdown, stem, table);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "k4reg-bench-blind: %s\n", e.what());
     return 1;

@@ -220,6 +220,12 @@ struct Verdict {
   double margin = 1.0;                 // (winner - runner-up) / winner, on the refined scores
   bool on_surface = true;              // whether the winner lies on the target surface
   int iterations = 0;                  // the winner's ICP iterations
+  // The surface agreement of a contender that lies clearly more on the target surface than the winner (by
+  // kAmbiguousMargin of its own) while nearly as well supported; 0 where none does. The two figures then
+  // disagree: a periodic scene's shifted copy can explain as much of the source as the truth (the corridor's
+  // doors, free space seen the same from either station) yet fits its surfaces less closely (held-out corridor
+  // layout 2 in arbitrary frames: the copy 24 m off 0.84 on the surface, the contenders 0.98).
+  double disputed_by = 0.0;
 };
 
 Verdict judge_contenders(const SymmetryGuardResult& guarded, const IcpPyramid& source, const IcpPyramid& target,
@@ -277,6 +283,10 @@ Verdict judge_contenders(const SymmetryGuardResult& guarded, const IcpPyramid& s
   // The runner-up is the next contender of the winner's kind; failing one, the best unrefined hypothesis.
   const auto rival = std::find_if(kept.begin() + 1, kept.end(), [&](std::size_t i) { return on_surface(i) == verdict.on_surface; });
   const double winner_score = hypotheses[winner].refined_score;
+  for (std::size_t i : kept)
+    if (icp && on_surface(i) && hypotheses[i].refined_score >= (1.0 - kContenderBand) * winner_score &&
+        hypotheses[i].surface_agreement * (1.0 - kAmbiguousMargin) > hypotheses[winner].surface_agreement)
+      verdict.disputed_by = std::max(verdict.disputed_by, hypotheses[i].surface_agreement);
   if (rival != kept.end())
     verdict.margin = winner_score > 0 ? std::clamp((winner_score - hypotheses[*rival].refined_score) / winner_score, 0.0, 1.0) : 0.0;
   else if (contenders > 1)
@@ -501,7 +511,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   // Where the verdict cannot decide and the hypotheses show the scene repeating under a shift (a corridor's
   // doors every few metres), the truth may be a shifted copy that 4PCS did not find: the guard searches
   // wider, from the verdict's winner, and the verdict judges again. Only such pairs pay for it.
-  if (params.icp && verdict.margin < kAmbiguousMargin &&
+  if (params.icp && (verdict.margin < kAmbiguousMargin || verdict.disputed_by > 0.0) &&
       repeats_under_a_shift(verdict.hypotheses, 2.0 * icp.second.stages.front().voxel_m)) {
     const SymmetryGuardResult wider = timer.run("symmetry_guard", [&] {
       return rank_hypotheses(icp.first, icp.second, verdict.hypotheses, result.overlap_used, seen,
@@ -544,6 +554,12 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
     result.ambiguity_reason = fmt::format(
         "a runner-up pose is nearly as well supported (margin {:.3f} < {}): the scene may be symmetric; see the hypotheses",
         result.ambiguity_margin, kAmbiguousMargin);
+  } else if (verdict.disputed_by > 0.0) {
+    result.ambiguous = true;
+    result.ambiguity_reason = fmt::format(
+        "the evidence disagrees: the best supported pose lies {:.0f} % on the target surface, a runner-up nearly as "
+        "well supported {:.0f} %: the scene may repeat; see the hypotheses",
+        100 * best.surface_agreement, 100 * verdict.disputed_by);
   }
 
   result.transform = to_file_frames(local, source.origin_m, target.origin_m);
