@@ -57,8 +57,9 @@ RegistrationFlags add_registration_flags(CLI::App& command, RegistrationParams& 
   flags.free_space =
       command
           .add_option("--free-space", params.free_space,
-                      "judge poses by the scanners' free space: auto (terrestrial scans from their frame origin, or "
-                      "single object views), on (scanners at the frames' origins) or off")
+                      "judge poses by the scanners' free space: auto (terrestrial scans whose scanner position is "
+                      "known: from the file, the frame's origin or the scan's sampling; or single object views), on "
+                      "(the scanner positions known, else the frames' origins) or off (geometry alone)")
           ->transform(CLI::CheckedTransformer(free_space, CLI::ignore_case));
   const std::map<std::string, CoarseMethod> methods{{"k4pcs", CoarseMethod::kKeypoint4pcs},
                                                     {"4pcs", CoarseMethod::kPlain4pcs}};

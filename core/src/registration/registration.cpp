@@ -12,6 +12,7 @@
 #include <limits>
 #include <optional>
 
+#include "k4reg/registration/ambiguity_margin.h"
 #include "k4reg/registration/dog_keypoints.h"
 #include "k4reg/registration/fine_polish.h"
 #include "k4reg/registration/prepared_scan.h"
@@ -549,11 +550,13 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
     result.ambiguity_reason = fmt::format(
         "poorly supported: the best pose explains {:.0f} % of the source once refined (true poses: {:.0f} % or more)",
         100 * best.refined_score, 100 * needed);
-  } else if (result.hypotheses.size() >= 2 && result.ambiguity_margin < kAmbiguousMargin) {
+  } else if (result.hypotheses.size() >= 2 && result.ambiguity_margin < ambiguous_below(result.free_space_used)) {
     result.ambiguous = true;
     result.ambiguity_reason = fmt::format(
-        "a runner-up pose is nearly as well supported (margin {:.3f} < {}): the scene may be symmetric; see the hypotheses",
-        result.ambiguity_margin, kAmbiguousMargin);
+        "a runner-up pose is nearly as well supported (margin {:.3f} < {}{}): the scene may be symmetric; see the "
+        "hypotheses",
+        result.ambiguity_margin, ambiguous_below(result.free_space_used),
+        result.free_space_used ? "" : ", judged on geometry alone");
   } else if (verdict.disputed_by > 0.0) {
     result.ambiguous = true;
     result.ambiguity_reason = fmt::format(

@@ -101,7 +101,8 @@ struct Hypothesis {
 // supported.
 constexpr double kMinSurfaceAgreement = 0.75;
 
-// Below this margin between the best pose and the runner-up, the result is flagged ambiguous.
+// Below this margin between the best pose and the runner-up, a result judged with free space is flagged ambiguous
+// (on geometry alone it needs more: ambiguity_margin.h).
 constexpr double kAmbiguousMargin = 0.05;
 
 struct StageTiming {
@@ -128,7 +129,7 @@ struct RegistrationResult {
   double overlap_used = 0.0;      // the overlap whose bases found it
   // (best - runner-up) / best, on the evidence that decided (fine geometry and intensity); small = ambiguous.
   double ambiguity_margin = 0.0;
-  // The evidence cannot tell the best pose from a runner-up (margin under kAmbiguousMargin), or the
+  // The evidence cannot tell the best pose from a runner-up (margin under ambiguous_below: ambiguity_margin.h), or the
   // best pose is poorly supported: treat the transform as one of several candidates (see hypotheses).
   bool ambiguous = false;
   std::string ambiguity_reason;  // why, in words; empty when not ambiguous
