@@ -74,7 +74,7 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
                          memory,
                          paths,
                          spool,
-                         JobLimits{config.max_points, config.job_threads},
+                         JobLimits{config.max_points, config.job_threads, config.max_project_scans, config.max_project_points},
                          config.auth_token,
                          std::uint64_t(config.max_upload_mb) << 20,
                          std::uint64_t(config.max_inline_mb) << 20,

@@ -57,6 +57,15 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
   app.add_option("--max-points", c.max_points, "points per cloud, 0 = unlimited")
       ->envname("K4REG_MAX_POINTS")
       ->capture_default_str();
+  app.add_option("--max-project-scans", c.max_project_scans, "scans per project request (each may be an upload)")
+      ->envname("K4REG_MAX_PROJECT_SCANS")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--max-project-points", c.max_project_points,
+                 "points per project, all scans together, as their headers declare them")
+      ->envname("K4REG_MAX_PROJECT_POINTS")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--memory-budget-mb", c.memory_budget_mb,
                  "estimated memory of all running jobs (60 bytes per input point), 0 = half the RAM")
       ->envname("K4REG_MEMORY_BUDGET_MB");
@@ -149,6 +158,8 @@ nlohmann::json config_to_json(const ServerConfig& c) {
           {"max_pair_mb", c.max_pair_mb},
           {"job_threads", c.job_threads},
           {"max_points", c.max_points},
+          {"max_project_scans", c.max_project_scans},
+          {"max_project_points", c.max_project_points},
           {"memory_budget_mb", c.memory_budget_mb},
           {"spool_dir", c.spool_dir},
           {"drain_grace_s", c.drain_grace_s},

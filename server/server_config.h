@@ -25,6 +25,8 @@ struct ServerConfig {
   std::size_t pair_cache_mb = 512;            // scans of peers' pair jobs kept, with their preparation
   int job_threads = 1;                        // core threads per job; parallelism comes from the workers
   std::size_t max_points = 50'000'000;        // per cloud; 0 = unlimited
+  std::size_t max_project_scans = 500;         // scans (and so uploads) per project request
+  std::uint64_t max_project_points = 500'000'000;  // points per project, as the scans' headers declare them
   std::size_t memory_budget_mb = 0;           // for all running jobs; 0 = half the physical memory
   std::string spool_dir;                      // parent of the per-process upload directory; "" = system temp
   double drain_grace_s = 25.0;                // after SIGTERM, running jobs get this long before cancellation

@@ -81,7 +81,7 @@ void ServiceContext::check_inline_size(std::size_t bytes) const {
                                                     double(bytes) / (1 << 20), max_inline_bytes >> 20));
 }
 
-CloudSource ServiceContext::referenced_cloud(const std::string& path) const { return {path, paths.resolve(path), {}}; }
+CloudSource ServiceContext::referenced_cloud(const std::string& path) const { return {path, paths.resolve(path), {}, &paths}; }
 
 CloudSource ServiceContext::cloud_source(const v1::CloudInput& input, const char* role) const {
   switch (input.kind_case()) {
