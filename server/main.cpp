@@ -82,7 +82,9 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
                          metrics,
                          config.peers.empty() ? nullptr : make_peer_channel(config.peers, tls),
                          PeerOptions{.in_flight = config.peer_in_flight,
-                                     .max_pair_bytes = static_cast<std::uint64_t>(config.max_pair_mb * (1 << 20))}};
+                                     .max_pair_bytes = static_cast<std::uint64_t>(config.max_pair_mb * (1 << 20)),
+                                     .call_timeout_s = config.peer_timeout_s,
+                                     .token = config.peer_token}};
   RegistrationService service(context);
   std::unique_ptr<HttpServer> http;
   if (!config.http_listen.empty()) http = std::make_unique<HttpServer>(context, config.http_listen, tls);

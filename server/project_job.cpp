@@ -101,7 +101,7 @@ grpc::Status run_project_job(const ServiceContext& service, Job& job, const Proj
     // With --peers the pairs go out to the deployment; the poses are the same either way.
     std::optional<PeerPairRunner> runner;
     if (service.peers)
-      runner.emplace(service.peers, service.peer_options, PeerCaller{record.request_id, service.auth_token},
+      runner.emplace(service.peers, service.peer_options, PeerCaller{record.request_id, service.pair_token()},
                      service.metrics, placement);
     const ProjectOutcome outcome =
         run_project(project.scans, project.names, project.params, project.preview_points, service.limits,

@@ -50,6 +50,14 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
       ->envname("K4REG_PEER_IN_FLIGHT")
       ->capture_default_str()
       ->check(CLI::Range(1, 1024));
+  app.add_option("--peer-timeout-s", c.peer_timeout_s, "deadline of one pair call to a peer; then it is retried")
+      ->envname("K4REG_PEER_TIMEOUT_S")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--peer-token", c.peer_token,
+                 "bearer token of pair jobs between replicas: sent with them and required of them (a client's "
+                 "--auth-token then cannot submit them); empty = --auth-token")
+      ->envname("K4REG_PEER_TOKEN");
   app.add_option("--job-threads", c.job_threads, "core threads per job (caps the request's params.threads)")
       ->envname("K4REG_JOB_THREADS")
       ->capture_default_str()
@@ -154,6 +162,8 @@ nlohmann::json config_to_json(const ServerConfig& c) {
           {"pair_workers", c.pair_workers},
           {"pair_queue_size", c.pair_queue_size},
           {"peer_in_flight", c.peer_in_flight},
+          {"peer_timeout_s", c.peer_timeout_s},
+          {"peer_auth", !c.peer_token.empty()},
           {"pair_cache_mb", c.pair_cache_mb},
           {"max_pair_mb", c.max_pair_mb},
           {"job_threads", c.job_threads},

@@ -22,6 +22,8 @@ struct ServerConfig {
   std::size_t pair_workers = 0;               // RegisterPair jobs at once (peers' pairs); 0 = workers
   std::size_t pair_queue_size = 16;           // RegisterPair jobs waiting; beyond: RESOURCE_EXHAUSTED (backpressure)
   int peer_in_flight = 4;                     // a coordinated project's pairs out at once
+  double peer_timeout_s = 900;                // deadline of one pair call to a peer
+  std::string peer_token;                     // if set, pair jobs (RegisterPair) need it instead of --auth-token
   std::size_t pair_cache_mb = 512;            // scans of peers' pair jobs kept, with their preparation
   int job_threads = 1;                        // core threads per job; parallelism comes from the workers
   std::size_t max_points = 50'000'000;        // per cloud; 0 = unlimited
