@@ -59,7 +59,7 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
   log_json(spdlog::level::info, "starting", {{"version", K4REG_VERSION}, {"config", config_to_json(config)}});
   const std::optional<TlsConfig> tls = load_tls(config);
   const PathPolicy paths(config.data_roots);
-  SpoolDir spool(config.spool_dir);
+  SpoolDir spool(config.spool_dir, config.max_spool_files);
   MemoryBudget memory(config.memory_budget_mb << 20);
   JobQueue queue(config.workers, config.queue_size);
   JobQueue pair_queue(config.pair_workers, config.pair_queue_size);

@@ -100,6 +100,11 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
       ->envname("K4REG_MAX_UPLOAD_MB")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  app.add_option("--max-spool-files", c.max_spool_files,
+                 "uploaded files held at once, all calls together (each declared upload holds one until its call ends)")
+      ->envname("K4REG_MAX_SPOOL_FILES")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--max-inline-mb", c.max_inline_mb, "largest unary request (inline clouds), MiB")
       ->envname("K4REG_MAX_INLINE_MB")
       ->capture_default_str()
@@ -177,6 +182,7 @@ nlohmann::json config_to_json(const ServerConfig& c) {
           {"tls", !c.tls_cert.empty()},
           {"tls_client_ca", c.tls_client_ca},
           {"max_upload_mb", c.max_upload_mb},
+          {"max_spool_files", c.max_spool_files},
           {"max_inline_mb", c.max_inline_mb},
           {"max_connection_age_s", c.max_connection_age_s},
           {"max_connection_age_grace_s", c.max_connection_age_grace_s},

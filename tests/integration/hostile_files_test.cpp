@@ -7,6 +7,7 @@
 #include <fstream>
 #include <functional>
 #include <string>
+#include <thread>
 
 #include "k4reg/io/cloud_io.h"
 #include "k4reg/util/crc32c.h"
@@ -75,6 +76,23 @@ class HostileFiles : public ::testing::Test {
     swap(root() / "victim.ply");
     running_context->TryCancel();  // the worker moves on to the queued job
     return queued.finish();
+  }
+
+  // A RegisterProjectStream call that declares `uploads` uploads and ends without sending a byte of them.
+  grpc::Status stream_project_header(int uploads) {
+    v1::RegisterProjectStreamRequest header;
+    for (int i = 0; i < uploads; ++i) {
+      v1::UploadedFile& upload = *header.mutable_header()->add_scans()->mutable_upload();
+      upload.set_file_name("scan.xyz");
+      upload.set_size_bytes(1000);
+    }
+    const auto context = context_with_deadline(30s);
+    auto stream = stub_->RegisterProjectStream(context.get());
+    stream->Write(header);
+    stream->WritesDone();
+    for (v1::RegisterProjectEvent event; stream->Read(&event);) {
+    }
+    return stream->Finish();
   }
 
   grpc::Status register_project(const v1::RegisterProjectRequest& request) {
@@ -174,19 +192,7 @@ TEST_F(ProjectCaps, AProjectOverItsScansOrPointsIsRefusedNamingTheFlag) {
   EXPECT_TRUE(has_status(register_project(request), grpc::StatusCode::RESOURCE_EXHAUSTED, "--max-project-points"));
 
   // A streamed project is refused from its header, before any upload is spooled.
-  v1::RegisterProjectStreamRequest header;
-  for (int i = 0; i < 3; ++i) {
-    v1::UploadedFile& upload = *header.mutable_header()->add_scans()->mutable_upload();
-    upload.set_file_name("scan.xyz");
-    upload.set_size_bytes(1000);
-  }
-  const auto context = context_with_deadline(30s);
-  auto stream = stub_->RegisterProjectStream(context.get());
-  stream->Write(header);
-  stream->WritesDone();
-  for (v1::RegisterProjectEvent event; stream->Read(&event);) {
-  }
-  EXPECT_TRUE(has_status(stream->Finish(), grpc::StatusCode::RESOURCE_EXHAUSTED, "--max-project-scans"));
+  EXPECT_TRUE(has_status(stream_project_header(3), grpc::StatusCode::RESOURCE_EXHAUSTED, "--max-project-scans"));
   EXPECT_EQ(server_->spooled_files(), 0u);
 
   // Over HTTP, the form's third scan part is refused with 413.
@@ -194,6 +200,28 @@ TEST_F(ProjectCaps, AProjectOverItsScansOrPointsIsRefusedNamingTheFlag) {
                                 server_->http_url() + "/v1/register-project"});
   EXPECT_EQ(reply.status, 413) << reply.body;
   EXPECT_NE(reply.body.find("--max-project-scans"), std::string::npos) << reply.body;
+}
+
+class SpoolFiles : public HostileFiles {
+ protected:
+  SpoolFiles() : HostileFiles({"--max-spool-files", "2"}) {}
+};
+
+TEST_F(SpoolFiles, UploadsDeclaredBeyondTheServersSpoolFilesAreRefusedNamingTheFlag) {
+  EXPECT_TRUE(has_status(stream_project_header(3), grpc::StatusCode::RESOURCE_EXHAUSTED, "--max-spool-files"));
+  EXPECT_EQ(server_->spooled_files(), 0u);  // the two it had created went with the call
+  // Two files held by one call in flight leave none for the next.
+  const auto holding_context = context_with_deadline(30s);
+  auto holding = stub_->RegisterStream(holding_context.get());
+  v1::RegisterStreamRequest header;  // the header only: the uploads never come
+  *header.mutable_header() = upload_header("a.xyz", sphere_xyz(), "b.xyz", sphere_xyz(), quick_params());
+  ASSERT_TRUE(holding->Write(header));
+  for (const auto until = std::chrono::steady_clock::now() + 10s;
+       server_->spooled_files() < 2 && std::chrono::steady_clock::now() < until;)
+    std::this_thread::sleep_for(10ms);
+  EXPECT_TRUE(has_status(stream_project_header(2), grpc::StatusCode::RESOURCE_EXHAUSTED, "--max-spool-files"));
+  holding_context->TryCancel();
+  EXPECT_EQ(holding->Finish().error_code(), grpc::StatusCode::CANCELLED);
 }
 
 }  // namespace
