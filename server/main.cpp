@@ -60,6 +60,7 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
   const std::optional<TlsConfig> tls = load_tls(config);
   const PathPolicy paths(config.data_roots);
   SpoolDir spool(config.spool_dir, config.max_spool_files);
+  UploadIdleWatch idle_uploads(config.upload_idle_timeout_s);
   MemoryBudget memory(config.memory_budget_mb << 20);
   JobQueue queue(config.workers, config.queue_size);
   JobQueue pair_queue(config.pair_workers, config.pair_queue_size);
@@ -74,6 +75,7 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
                          memory,
                          paths,
                          spool,
+                         idle_uploads,
                          JobLimits{config.max_points, config.job_threads, config.max_project_scans, config.max_project_points},
                          config.auth_token,
                          std::uint64_t(config.max_upload_mb) << 20,

@@ -105,6 +105,11 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
       ->envname("K4REG_MAX_SPOOL_FILES")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  app.add_option("--upload-idle-timeout-s", c.upload_idle_timeout_s,
+                 "end an upload call (RegisterStream, RegisterProjectStream) that sends no message this long")
+      ->envname("K4REG_UPLOAD_IDLE_TIMEOUT_S")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--max-inline-mb", c.max_inline_mb, "largest unary request (inline clouds), MiB")
       ->envname("K4REG_MAX_INLINE_MB")
       ->capture_default_str()
@@ -183,6 +188,7 @@ nlohmann::json config_to_json(const ServerConfig& c) {
           {"tls_client_ca", c.tls_client_ca},
           {"max_upload_mb", c.max_upload_mb},
           {"max_spool_files", c.max_spool_files},
+          {"upload_idle_timeout_s", c.upload_idle_timeout_s},
           {"max_inline_mb", c.max_inline_mb},
           {"max_connection_age_s", c.max_connection_age_s},
           {"max_connection_age_grace_s", c.max_connection_age_grace_s},

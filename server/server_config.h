@@ -38,6 +38,7 @@ struct ServerConfig {
   std::string health_listen;                  // plaintext health-only listener; "" = none
   std::size_t max_upload_mb = 4096;           // per streamed file
   std::size_t max_spool_files = 1000;         // uploads in flight on the server, all calls together
+  double upload_idle_timeout_s = 60;          // an upload call that sends nothing this long is ended
   std::size_t max_inline_mb = 32;             // per Register / RegisterProject request (inline clouds)
   double max_pair_mb = 1024;                  // per RegisterPair request (a peer's pair job); gRPC's message limit
   double max_connection_age_s = 0;            // 0 = unlimited; otherwise GOAWAY after ~this long (rebalancing)

@@ -20,6 +20,7 @@
 #include "scan_cache.h"
 #include "request_log.h"
 #include "spool.h"
+#include "upload_idle_watch.h"
 
 namespace k4reg::service {
 
@@ -30,6 +31,7 @@ struct ServiceContext {
   MemoryBudget& memory;
   const PathPolicy& paths;
   SpoolDir& spool;
+  UploadIdleWatch& idle_uploads;
   JobLimits limits;
   std::string auth_token;
   std::uint64_t max_upload_bytes = 0;  // per uploaded file (RegisterStream, HTTP multipart)

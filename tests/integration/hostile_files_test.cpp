@@ -224,5 +224,30 @@ TEST_F(SpoolFiles, UploadsDeclaredBeyondTheServersSpoolFilesAreRefusedNamingTheF
   EXPECT_EQ(holding->Finish().error_code(), grpc::StatusCode::CANCELLED);
 }
 
+class IdleUploads : public HostileFiles {
+ protected:
+  IdleUploads() : HostileFiles({"--upload-idle-timeout-s", "1"}) {}
+};
+
+TEST_F(IdleUploads, AnUploadThatStopsSendingIsEndedAndItsSpoolFilesGo) {
+  const auto context = context_with_deadline(30s);
+  auto stream = stub_->RegisterStream(context.get());
+  v1::RegisterStreamRequest header;  // the header, then nothing
+  *header.mutable_header() = upload_header("a.xyz", sphere_xyz(), "b.xyz", sphere_xyz(), quick_params());
+  ASSERT_TRUE(stream->Write(header));
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(stream->Finish().ok());
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 5s);
+  // The client sees the cancellation at once; the server's account of it follows.
+  std::vector<nlohmann::json> requests;
+  for (const auto until = std::chrono::steady_clock::now() + 5s;
+       requests.empty() && std::chrono::steady_clock::now() < until; requests = server_->log_lines("request"))
+    std::this_thread::sleep_for(20ms);
+  ASSERT_EQ(requests.size(), 1u);
+  EXPECT_EQ(server_->spooled_files(), 0u);
+  EXPECT_EQ(requests[0].value("code", ""), "DEADLINE_EXCEEDED");
+  EXPECT_NE(requests[0].value("error", "").find("--upload-idle-timeout-s"), std::string::npos) << requests[0].dump();
+}
+
 }  // namespace
 }  // namespace k4reg::test
