@@ -25,9 +25,12 @@ void declare_points(std::uint64_t most) {
 
 std::uint64_t declared_points(std::string_view data, const std::string& name, const ReadOptions& options) {
   const CloudFormat format = detect_format_bytes(data, name);
-  // Text holds at most one point per line; counting lines is cheap next to parsing them.
-  if (format == CloudFormat::kXyz || format == CloudFormat::kPtx)
-    return static_cast<std::uint64_t>(std::count(data.begin(), data.end(), '\n')) + 1;
+  // Text holds at most one point per line; counting lines is cheap next to parsing them. The text readers refuse
+  // a file rather than hold more than options.max_points.
+  if (format == CloudFormat::kXyz || format == CloudFormat::kPtx) {
+    const std::uint64_t lines = static_cast<std::uint64_t>(std::count(data.begin(), data.end(), '\n')) + 1;
+    return options.max_points == 0 ? lines : std::min<std::uint64_t>(lines, options.max_points);
+  }
   // The binary readers declare their count (io_detail::check_point_budget) before allocating: run one up to there.
   struct Counting {
     Counting() { io_detail::counting_only = true; }

@@ -12,8 +12,8 @@ namespace k4reg {
 
 // The most points read_cloud_bytes(data, name, options) can return, nothing decoded or allocated for them: the
 // count a PLY, PCD or LAS header declares, the records of the selected E57 scans, the number of lines of a text
-// format (XYZ, PTX). Throws as read_cloud_bytes does for a header it cannot read, and kResourceExhausted for a
-// declared count over options.max_points.
+// format (XYZ, PTX; at most options.max_points, which their readers never pass). Throws as read_cloud_bytes does for
+// a header it cannot read, and kResourceExhausted for a declared count over options.max_points.
 std::uint64_t declared_points(std::string_view data, const std::string& name, const ReadOptions& options = {});
 
 }  // namespace k4reg
