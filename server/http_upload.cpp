@@ -92,6 +92,7 @@ UploadForm read_upload_form(RequestBody& body, const ServiceContext& service, Fo
     }
     if (kind == FormKind::kPair && std::find(cloud_roles.begin(), cloud_roles.end(), part.name) != cloud_roles.end())
       fail(ErrorCode::kInvalidArgument, "form part '" + part.name + "' given twice");
+    service.limits.check_project_scans(cloud_roles.size() + 1);  // before its spool file
     cloud_roles.push_back(part.name);
     paths.emplace_back();
     form.clouds.emplace_back();

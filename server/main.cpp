@@ -59,7 +59,8 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
   log_json(spdlog::level::info, "starting", {{"version", K4REG_VERSION}, {"config", config_to_json(config)}});
   const std::optional<TlsConfig> tls = load_tls(config);
   const PathPolicy paths(config.data_roots);
-  SpoolDir spool(config.spool_dir);
+  SpoolDir spool(config.spool_dir, config.max_spool_files);
+  UploadIdleWatch idle_uploads(config.upload_idle_timeout_s);
   MemoryBudget memory(config.memory_budget_mb << 20);
   JobQueue queue(config.workers, config.queue_size);
   JobQueue pair_queue(config.pair_workers, config.pair_queue_size);
@@ -74,7 +75,8 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
                          memory,
                          paths,
                          spool,
-                         JobLimits{config.max_points, config.job_threads},
+                         idle_uploads,
+                         JobLimits{config.max_points, config.job_threads, config.max_project_scans, config.max_project_points},
                          config.auth_token,
                          std::uint64_t(config.max_upload_mb) << 20,
                          std::uint64_t(config.max_inline_mb) << 20,
@@ -82,7 +84,9 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
                          metrics,
                          config.peers.empty() ? nullptr : make_peer_channel(config.peers, tls),
                          PeerOptions{.in_flight = config.peer_in_flight,
-                                     .max_pair_bytes = static_cast<std::uint64_t>(config.max_pair_mb * (1 << 20))}};
+                                     .max_pair_bytes = static_cast<std::uint64_t>(config.max_pair_mb * (1 << 20)),
+                                     .call_timeout_s = config.peer_timeout_s,
+                                     .token = config.peer_token}};
   RegistrationService service(context);
   std::unique_ptr<HttpServer> http;
   if (!config.http_listen.empty()) http = std::make_unique<HttpServer>(context, config.http_listen, tls);

@@ -11,7 +11,7 @@ PairReactor::PairReactor(ServiceContext& service, grpc::CallbackServerContext* c
                          const v1::RegisterPairRequest* request, v1::RegisterPairResponse* reply)
     : service_(service), reply_(reply) {
   record_ = open_request(*context, "/k4reg.v1.Registration/RegisterPair");
-  if (const grpc::Status status = service_.admit(*context); !status.ok()) {
+  if (const grpc::Status status = service_.admit_pair(*context); !status.ok()) {
     finish(status);
     return;
   }

@@ -1,6 +1,8 @@
 // Which files a request may reference: existing regular files under the configured data roots.
 // Every path is resolved (".." and symlinks) before the containment check, so neither "../x", nor an
-// absolute path elsewhere, nor a symlink inside a root that leads out of it gets through.
+// absolute path elsewhere, nor a symlink inside a root that leads out of it gets through. The file is opened
+// later, after the queue wait: open() checks again where the path leads then, so a symlink swapped in meanwhile
+// cannot lead out of the roots either, and a FIFO swapped in is refused instead of blocking the worker.
 #pragma once
 
 #include <filesystem>
@@ -20,8 +22,16 @@ class PathPolicy {
   // regular file. Messages name the path as requested, never the server's roots.
   std::string resolve(const std::string& requested) const;
 
+  // A descriptor for reading `resolved` (what resolve() returned), where the path leads now: beneath its root
+  // (openat2 RESOLVE_BENEATH | RESOLVE_NO_MAGICLINKS; on kernels without openat2, through no symlink at all) and
+  // a regular file, opened without blocking on a FIFO. The caller closes it. Throws k4reg::Error naming
+  // `requested`: kPermissionDenied when the path now leads out of its root, kNotFound when it is gone,
+  // kInvalidArgument when it is no regular file.
+  int open(const std::string& resolved, const std::string& requested) const;
+
  private:
-  bool inside_a_root(const std::filesystem::path& canonical) const;
+  // The root `canonical` lies in, or null.
+  const std::filesystem::path* root_of(const std::filesystem::path& canonical) const;
 
   std::vector<std::filesystem::path> roots_;  // canonical
 };

@@ -7,6 +7,7 @@
 #include "k4reg/v1/registration.grpc.pb.h"
 #include "messages_to_core.h"
 #include "metrics.h"
+#include "peer_reply.h"
 #include "proto_convert.h"
 #include "status_name.h"
 
@@ -92,12 +93,20 @@ void PeerPairRunner::run(const std::vector<PreparedScan>& scans, const std::vect
     bool with_points = false;
     for (int failed = 0; fits && failed < options_.attempts && !stop;) {
       grpc::ClientContext context;
+      context.set_deadline(std::chrono::system_clock::now() +
+                           std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                               std::chrono::duration<double>(options_.call_timeout_s)));
       context.AddMetadata("x-request-id", caller_.request_id);
       if (!caller_.auth_token.empty()) context.AddMetadata("authorization", "Bearer " + caller_.auth_token);
       v1::RegisterPairResponse reply;
       calls.add(&context);
-      const grpc::Status status = stub->RegisterPair(&context, request, &reply);
+      grpc::Status status = stub->RegisterPair(&context, request, &reply);
       calls.remove(&context);
+      if (status.ok())
+        if (const std::string problem = reply_problem(reply, scans[pairs[k].first].cloud().size(),
+                                                      scans[pairs[k].second].cloud().size());
+            !problem.empty())
+          status = {grpc::StatusCode::INTERNAL, "the peer's reply is unusable: " + problem};
       const std::string peer = context.peer().empty() ? "none" : context.peer();
       metrics_.peer_pair_sent(peer, request.ByteSizeLong());
       if (status.error_code() == grpc::StatusCode::NOT_FOUND && !with_points) {

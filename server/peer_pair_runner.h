@@ -8,6 +8,8 @@
 // intensity. Each scan is encoded once per project. The peer computes register_clouds on exactly these numbers,
 // so the poses equal the in-process ones bit for bit.
 //
+// A peer's reply is used only when it is a well-formed answer to the pair asked (peer_reply.h); a call past
+// PeerOptions::call_timeout_s or with a reply that is not is a failed call.
 // Nothing is lost: a call that fails (peer gone, draining, killed mid-pair) is sent again after a backoff, to
 // whichever peer the channel picks; RESOURCE_EXHAUSTED (the peer's pair queue is full) is backpressure: wait and
 // retry, counted as one failure only every 20 waits. After `attempts` failures, or when the pair is larger than a
@@ -34,10 +36,12 @@ struct PeerOptions {
   double first_backoff_s = 0.2;            // doubled after each retry, at most max_backoff_s
   double max_backoff_s = 5.0;
   std::uint64_t max_pair_bytes = 1ull << 30;  // the peers' --max-pair-mb: larger pairs run here
+  double call_timeout_s = 900;             // --peer-timeout-s: one pair call's deadline (a peer that stalls fails it)
+  std::string token;                       // --peer-token: sent with pair jobs and required of them; "" = none
 };
 
 // Who is asking: every pair call carries the project's request id (x-request-id, so the peers' logs tie the
-// pairs to the project) and the deployment's bearer token, if it has one.
+// pairs to the project) and the bearer token pair jobs need (PeerOptions::token, else the client token), if any.
 struct PeerCaller {
   std::string request_id;
   std::string auth_token;

@@ -6,6 +6,7 @@
 
 #include <set>
 
+#include "cloud_bytes.h"
 #include "k4reg/util/error.h"
 #include "peer_pair_runner.h"
 #include "project_convert.h"
@@ -29,18 +30,28 @@ ProjectOutcome run_project(const std::vector<CloudSource>& scans, const std::vec
   StageTracker progress(stages);
   const auto load_start = Clock::now();
   progress("load", 0.0);
-  std::vector<PointCloud> clouds;
+  const ReadOptions options{limits.max_points};
+  std::vector<CloudBytes> bytes;
+  std::uint64_t declared = 0;
   for (const CloudSource& scan : scans) {
-    clouds.push_back(load_cloud(scan, ReadOptions{limits.max_points}));
+    bytes.emplace_back(scan);
+    declared += declared_cloud_points(scan, bytes.back().bytes(), options);
+  }
+  limits.check_project_points(declared);
+  // Reserved before decoding, for every scan at once: they stay in memory for the whole project (one pair at a
+  // time works on two of them), and a job holding some while it waits for more could wait for another such job.
+  const MemoryBudget::Reservation reservation = memory.reserve(kBytesPerPoint * declared, token);
+  std::vector<PointCloud> clouds;
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    clouds.push_back(load_cloud(scans[i], bytes[i].bytes(), options));
     report.points += clouds.back().size();
     progress("load", static_cast<double>(clouds.size()) / scans.size());
     token.throw_if_stopped();
   }
+  bytes.clear();
   progress("load", 1.0);
   report.load_s = seconds_since(load_start);
 
-  // Every scan stays in memory for the whole project; one pair at a time works on two of them.
-  const MemoryBudget::Reservation reservation = memory.reserve(kBytesPerPoint * report.points, token);
   if (params.pairwise.threads == 0 || params.pairwise.threads > limits.job_threads) params.pairwise.threads = limits.job_threads;
   const auto start = Clock::now();
   const ProgressCallback callback = [&](const std::string& stage, double fraction) { progress(stage, fraction); };
@@ -72,6 +83,7 @@ ProjectJob make_project_job(std::vector<CloudSource> scans, const v1::ProjectPar
 }
 
 ProjectJob project_job_from_proto(const ServiceContext& service, const v1::RegisterProjectRequest& request) {
+  service.limits.check_project_scans(static_cast<std::size_t>(request.scans_size()));
   std::vector<CloudSource> scans;
   for (int i = 0; i < request.scans_size(); ++i)
     scans.push_back(service.cloud_source(request.scans(i), fmt::format("scan {}", i).c_str()));
@@ -89,7 +101,7 @@ grpc::Status run_project_job(const ServiceContext& service, Job& job, const Proj
     // With --peers the pairs go out to the deployment; the poses are the same either way.
     std::optional<PeerPairRunner> runner;
     if (service.peers)
-      runner.emplace(service.peers, service.peer_options, PeerCaller{record.request_id, service.auth_token},
+      runner.emplace(service.peers, service.peer_options, PeerCaller{record.request_id, service.pair_token()},
                      service.metrics, placement);
     const ProjectOutcome outcome =
         run_project(project.scans, project.names, project.params, project.preview_points, service.limits,

@@ -13,6 +13,7 @@ ProjectStreamReactor::ProjectStreamReactor(ServiceContext& service, grpc::Callba
 
 void ProjectStreamReactor::on_header(const v1::RegisterProjectStreamRequest& request) {
   const v1::ProjectUploadHeader& header = request.header();
+  service_.limits.check_project_scans(static_cast<std::size_t>(header.scans_size()));  // before any spool file
   std::vector<CloudSource> scans;
   for (int i = 0; i < header.scans_size(); ++i) scans.push_back(uploads_.add(header.scans(i), fmt::format("scan {}", i)));
   project_ = make_project_job(std::move(scans), header.params(), header.preview_points());

@@ -3,6 +3,7 @@
 #include <openssl/evp.h>
 
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -196,6 +197,8 @@ PointCloud cloud_from_proto(const v1::PairCloud& m, std::size_t max_points) {
   if (!cloud.origin_m.allFinite()) fail(ErrorCode::kInvalidArgument, name + ": origin_m is not finite");
   for (const Eigen::Vector3f& p : cloud.points)
     if (!p.allFinite()) fail(ErrorCode::kInvalidArgument, name + ": a point is NaN or infinite");
+  for (const float value : cloud.intensity)
+    if (!std::isfinite(value)) fail(ErrorCode::kInvalidArgument, name + ": an intensity is NaN or infinite");
   return cloud;
 }
 

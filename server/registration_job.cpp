@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <chrono>
 
+#include <fmt/format.h>
+
+#include "cloud_bytes.h"
 #include "k4reg/io/cloud_io.h"
+#include "k4reg/io/declared_points.h"
 #include "k4reg/util/error.h"
 
 namespace k4reg::service {
@@ -15,17 +19,39 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 
 }  // namespace
 
-PointCloud load_cloud(const CloudSource& source, const ReadOptions& options) {
+void JobLimits::check_project_scans(std::size_t scans) const {
+  if (scans > max_project_scans)
+    fail(ErrorCode::kResourceExhausted,
+         fmt::format("a project of more than {} scans (--max-project-scans)", max_project_scans));
+}
+
+void JobLimits::check_project_points(std::uint64_t points) const {
+  if (points > max_project_points)
+    fail(ErrorCode::kResourceExhausted, fmt::format("the scans' headers declare {} points, more than the {} a project "
+                                                    "may have (--max-project-points)", points, max_project_points));
+}
+
+namespace {
+
+// The readers name the file as given (the client's name); a count over ReadOptions::max_points gets its flag.
+template <typename Read>
+auto read_naming_the_limit(const Read& read) {
   try {
-    if (source.file.empty()) return read_cloud_bytes(source.bytes, source.name, options);
-    return read_cloud(source.file, options);
+    return read();
   } catch (const Error& e) {
-    std::string message = e.what();
-    if (!source.file.empty() && message.rfind(source.file, 0) == 0)
-      message = source.name + message.substr(source.file.size());
-    if (e.code() == ErrorCode::kResourceExhausted) message += " (--max-points)";
-    throw Error(e.code(), message);
+    if (e.code() != ErrorCode::kResourceExhausted) throw;
+    throw Error(e.code(), std::string(e.what()) + " (--max-points)");
   }
+}
+
+}  // namespace
+
+std::uint64_t declared_cloud_points(const CloudSource& source, std::string_view bytes, const ReadOptions& options) {
+  return read_naming_the_limit([&] { return declared_points(bytes, source.name, options); });
+}
+
+PointCloud load_cloud(const CloudSource& source, std::string_view bytes, const ReadOptions& options) {
+  return read_naming_the_limit([&] { return read_cloud_bytes(bytes, source.name, options); });
 }
 
 void StageTracker::operator()(const std::string& stage, double fraction) {
@@ -62,16 +88,18 @@ RegistrationOutcome run_registration(const CloudSource& source, const CloudSourc
   const auto load_start = Clock::now();
   progress("load", 0.0);
   const ReadOptions options{limits.max_points};
-  const PointCloud source_cloud = load_cloud(source, options);
+  const CloudBytes source_bytes(source), target_bytes(target);
+  // Reserved before decoding: a small file can declare (and decode to) far more than its size.
+  const std::uint64_t declared = declared_cloud_points(source, source_bytes.bytes(), options) +
+                                 declared_cloud_points(target, target_bytes.bytes(), options);
+  const MemoryBudget::Reservation reservation = memory.reserve(kBytesPerPoint * declared, token);
+  const PointCloud source_cloud = load_cloud(source, source_bytes.bytes(), options);
   report.source_points = source_cloud.size();
   token.throw_if_stopped();
-  const PointCloud target_cloud = load_cloud(target, options);
+  const PointCloud target_cloud = load_cloud(target, target_bytes.bytes(), options);
   report.target_points = target_cloud.size();
   progress("load", 1.0);
   report.load_s = seconds_since(load_start);
-
-  const MemoryBudget::Reservation reservation =
-      memory.reserve(kBytesPerPoint * (source_cloud.size() + target_cloud.size()), token);
 
   if (params.threads == 0 || params.threads > limits.job_threads) params.threads = limits.job_threads;
   const auto start = Clock::now();

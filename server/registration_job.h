@@ -1,5 +1,5 @@
-// What a worker does for one request, whatever RPC it came from: load both clouds, reserve their memory,
-// run the core. Shared by the unary and the streaming reactor (and the HTTP API later).
+// What a worker does for one request, whatever RPC it came from: reserve the memory both clouds' headers declare,
+// load them, run the core. Shared by the unary and the streaming reactor (and the HTTP API later).
 #pragma once
 
 #include <cstddef>
@@ -17,16 +17,25 @@
 
 namespace k4reg::service {
 
+class PathPolicy;
+
 // A cloud as the worker reads it: a file (a resolved data-root path or a spool file) or inline bytes.
 struct CloudSource {
   std::string name;        // as the client named it: used in messages and as the format hint
   std::string file;        // empty = read `bytes`
   std::string_view bytes;  // owned by the request, which outlives the job
+  const PathPolicy* paths = nullptr;  // set for a data-root file: opened through it (PathPolicy::open)
 };
 
 struct JobLimits {
-  std::size_t max_points = 0;  // per cloud, 0 = unlimited
-  int job_threads = 1;         // core threads per job; the request may ask for fewer
+  std::size_t max_points = 0;                    // per cloud, 0 = unlimited
+  int job_threads = 1;                           // core threads per job; the request may ask for fewer
+  std::size_t max_project_scans = 500;           // --max-project-scans
+  std::uint64_t max_project_points = 500'000'000;  // --max-project-points: all scans, as their headers declare
+
+  // Throw k4reg::Error(kResourceExhausted) naming the limit and its flag.
+  void check_project_scans(std::size_t scans) const;
+  void check_project_points(std::uint64_t points) const;
 };
 
 // Filled as the job goes, so that a failed job still reports what it got to.
@@ -55,8 +64,10 @@ class StageTracker {
 std::optional<CloudPreview> preview_stage(std::size_t preview_points, StageTracker& progress,
                                           const std::function<CloudPreview(const PreviewParams&)>& make);
 
-// Reads a cloud; error messages name it as the client did (never a server path). Throws k4reg::Error.
-PointCloud load_cloud(const CloudSource& source, const ReadOptions& options);
+// The points the cloud's header declares (declared_points.h), nothing decoded yet; then the cloud itself, from the
+// same bytes (CloudBytes). Error messages name it as the client did (never a server path). Throw k4reg::Error.
+std::uint64_t declared_cloud_points(const CloudSource& source, std::string_view bytes, const ReadOptions& options);
+PointCloud load_cloud(const CloudSource& source, std::string_view bytes, const ReadOptions& options);
 
 // What a pair job answers: the result and, when asked for (preview_points > 0), the preview.
 struct RegistrationOutcome {

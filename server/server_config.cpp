@@ -50,6 +50,14 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
       ->envname("K4REG_PEER_IN_FLIGHT")
       ->capture_default_str()
       ->check(CLI::Range(1, 1024));
+  app.add_option("--peer-timeout-s", c.peer_timeout_s, "deadline of one pair call to a peer; then it is retried")
+      ->envname("K4REG_PEER_TIMEOUT_S")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--peer-token", c.peer_token,
+                 "bearer token of pair jobs between replicas: sent with them and required of them (a client's "
+                 "--auth-token then cannot submit them); empty = --auth-token")
+      ->envname("K4REG_PEER_TOKEN");
   app.add_option("--job-threads", c.job_threads, "core threads per job (caps the request's params.threads)")
       ->envname("K4REG_JOB_THREADS")
       ->capture_default_str()
@@ -57,6 +65,15 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
   app.add_option("--max-points", c.max_points, "points per cloud, 0 = unlimited")
       ->envname("K4REG_MAX_POINTS")
       ->capture_default_str();
+  app.add_option("--max-project-scans", c.max_project_scans, "scans per project request (each may be an upload)")
+      ->envname("K4REG_MAX_PROJECT_SCANS")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--max-project-points", c.max_project_points,
+                 "points per project, all scans together, as their headers declare them")
+      ->envname("K4REG_MAX_PROJECT_POINTS")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--memory-budget-mb", c.memory_budget_mb,
                  "estimated memory of all running jobs (60 bytes per input point), 0 = half the RAM")
       ->envname("K4REG_MEMORY_BUDGET_MB");
@@ -81,6 +98,16 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
       ->needs(cert);
   app.add_option("--max-upload-mb", c.max_upload_mb, "largest streamed file, MiB")
       ->envname("K4REG_MAX_UPLOAD_MB")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--max-spool-files", c.max_spool_files,
+                 "uploaded files held at once, all calls together (each declared upload holds one until its call ends)")
+      ->envname("K4REG_MAX_SPOOL_FILES")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--upload-idle-timeout-s", c.upload_idle_timeout_s,
+                 "end an upload call (RegisterStream, RegisterProjectStream) that sends no message this long")
+      ->envname("K4REG_UPLOAD_IDLE_TIMEOUT_S")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_option("--max-inline-mb", c.max_inline_mb, "largest unary request (inline clouds), MiB")
@@ -145,10 +172,14 @@ nlohmann::json config_to_json(const ServerConfig& c) {
           {"pair_workers", c.pair_workers},
           {"pair_queue_size", c.pair_queue_size},
           {"peer_in_flight", c.peer_in_flight},
+          {"peer_timeout_s", c.peer_timeout_s},
+          {"peer_auth", !c.peer_token.empty()},
           {"pair_cache_mb", c.pair_cache_mb},
           {"max_pair_mb", c.max_pair_mb},
           {"job_threads", c.job_threads},
           {"max_points", c.max_points},
+          {"max_project_scans", c.max_project_scans},
+          {"max_project_points", c.max_project_points},
           {"memory_budget_mb", c.memory_budget_mb},
           {"spool_dir", c.spool_dir},
           {"drain_grace_s", c.drain_grace_s},
@@ -156,6 +187,8 @@ nlohmann::json config_to_json(const ServerConfig& c) {
           {"tls", !c.tls_cert.empty()},
           {"tls_client_ca", c.tls_client_ca},
           {"max_upload_mb", c.max_upload_mb},
+          {"max_spool_files", c.max_spool_files},
+          {"upload_idle_timeout_s", c.upload_idle_timeout_s},
           {"max_inline_mb", c.max_inline_mb},
           {"max_connection_age_s", c.max_connection_age_s},
           {"max_connection_age_grace_s", c.max_connection_age_grace_s},

@@ -22,9 +22,13 @@ struct ServerConfig {
   std::size_t pair_workers = 0;               // RegisterPair jobs at once (peers' pairs); 0 = workers
   std::size_t pair_queue_size = 16;           // RegisterPair jobs waiting; beyond: RESOURCE_EXHAUSTED (backpressure)
   int peer_in_flight = 4;                     // a coordinated project's pairs out at once
+  double peer_timeout_s = 900;                // deadline of one pair call to a peer
+  std::string peer_token;                     // if set, pair jobs (RegisterPair) need it instead of --auth-token
   std::size_t pair_cache_mb = 512;            // scans of peers' pair jobs kept, with their preparation
   int job_threads = 1;                        // core threads per job; parallelism comes from the workers
   std::size_t max_points = 50'000'000;        // per cloud; 0 = unlimited
+  std::size_t max_project_scans = 500;         // scans (and so uploads) per project request
+  std::uint64_t max_project_points = 500'000'000;  // points per project, as the scans' headers declare them
   std::size_t memory_budget_mb = 0;           // for all running jobs; 0 = half the physical memory
   std::string spool_dir;                      // parent of the per-process upload directory; "" = system temp
   double drain_grace_s = 25.0;                // after SIGTERM, running jobs get this long before cancellation
@@ -33,6 +37,8 @@ struct ServerConfig {
   std::string tls_client_ca;                  // PEM CA file: clients must present a certificate it signed
   std::string health_listen;                  // plaintext health-only listener; "" = none
   std::size_t max_upload_mb = 4096;           // per streamed file
+  std::size_t max_spool_files = 1000;         // uploads in flight on the server, all calls together
+  double upload_idle_timeout_s = 60;          // an upload call that sends nothing this long is ended
   std::size_t max_inline_mb = 32;             // per Register / RegisterProject request (inline clouds)
   double max_pair_mb = 1024;                  // per RegisterPair request (a peer's pair job); gRPC's message limit
   double max_connection_age_s = 0;            // 0 = unlimited; otherwise GOAWAY after ~this long (rebalancing)

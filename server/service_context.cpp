@@ -15,18 +15,27 @@ constexpr const char* kDraining = "server is draining; retry on another replica"
 
 }  // namespace
 
-grpc::Status ServiceContext::admit(const grpc::ServerContextBase& context) const {
-  grpc::Status status = check_bearer_token(context, auth_token);
-  if (!status.ok()) return status;
+namespace {
+
+// A call whose token checked out (`auth` OK) is admitted unless the server is draining.
+grpc::Status admitted(grpc::Status auth, const JobQueue& queue) {
+  if (!auth.ok()) return auth;
   if (!queue.accepting()) return {grpc::StatusCode::UNAVAILABLE, kDraining};
   return grpc::Status::OK;
 }
 
+}  // namespace
+
+grpc::Status ServiceContext::admit(const grpc::ServerContextBase& context) const {
+  return admitted(check_bearer_token(context, auth_token), queue);
+}
+
 grpc::Status ServiceContext::admit(std::optional<std::string_view> authorization) const {
-  grpc::Status status = check_bearer_token(authorization, auth_token);
-  if (!status.ok()) return status;
-  if (!queue.accepting()) return {grpc::StatusCode::UNAVAILABLE, kDraining};
-  return grpc::Status::OK;
+  return admitted(check_bearer_token(authorization, auth_token), queue);
+}
+
+grpc::Status ServiceContext::admit_pair(const grpc::ServerContextBase& context) const {
+  return admitted(check_bearer_token(context, pair_token()), queue);
 }
 
 grpc::Status ServiceContext::readiness() const {
@@ -81,7 +90,7 @@ void ServiceContext::check_inline_size(std::size_t bytes) const {
                                                     double(bytes) / (1 << 20), max_inline_bytes >> 20));
 }
 
-CloudSource ServiceContext::referenced_cloud(const std::string& path) const { return {path, paths.resolve(path), {}}; }
+CloudSource ServiceContext::referenced_cloud(const std::string& path) const { return {path, paths.resolve(path), {}, &paths}; }
 
 CloudSource ServiceContext::cloud_source(const v1::CloudInput& input, const char* role) const {
   switch (input.kind_case()) {

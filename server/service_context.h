@@ -20,6 +20,7 @@
 #include "scan_cache.h"
 #include "request_log.h"
 #include "spool.h"
+#include "upload_idle_watch.h"
 
 namespace k4reg::service {
 
@@ -30,6 +31,7 @@ struct ServiceContext {
   MemoryBudget& memory;
   const PathPolicy& paths;
   SpoolDir& spool;
+  UploadIdleWatch& idle_uploads;
   JobLimits limits;
   std::string auth_token;
   std::uint64_t max_upload_bytes = 0;  // per uploaded file (RegisterStream, HTTP multipart)
@@ -40,6 +42,10 @@ struct ServiceContext {
   // Auth, then draining: UNAUTHENTICATED / UNAVAILABLE, else OK. `authorization` as in check_bearer_token.
   grpc::Status admit(const grpc::ServerContextBase& context) const;
   grpc::Status admit(std::optional<std::string_view> authorization) const;
+  // RegisterPair: the same with the token pair jobs need, so that where the deployment sets a --peer-token, a
+  // client token alone cannot submit pair jobs.
+  grpc::Status admit_pair(const grpc::ServerContextBase& context) const;
+  const std::string& pair_token() const { return peer_options.token.empty() ? auth_token : peer_options.token; }
   // Readiness (gRPC "readiness" health, HTTP /readyz): UNAVAILABLE while draining or while the queue is full.
   grpc::Status readiness() const;
   // Queues the job; RESOURCE_EXHAUSTED when the queue is full, UNAVAILABLE when draining.

@@ -54,6 +54,7 @@ SpoolFile::~SpoolFile() {
   if (fd_ >= 0) ::close(fd_);
   std::error_code ec;
   fs::remove(path_, ec);
+  --live_;
 }
 
 void SpoolFile::append(std::string_view data) {
@@ -78,7 +79,7 @@ void SpoolFile::close() {
   if (result != 0) fail(ErrorCode::kInternal, std::string("cannot spool the upload: ") + std::strerror(errno));
 }
 
-SpoolDir::SpoolDir(const fs::path& parent) {
+SpoolDir::SpoolDir(const fs::path& parent, std::size_t max_files) : max_files_(max_files) {
   const std::string host_prefix = std::string(kPrefix) + host_name() + "-";
   path_ = parent / (host_prefix + std::to_string(getpid()));
   std::error_code ec;
@@ -96,11 +97,20 @@ SpoolDir::~SpoolDir() {
 }
 
 std::unique_ptr<SpoolFile> SpoolDir::create(const std::string& file_name) {
+  if (++live_ > max_files_) {
+    --live_;
+    fail(ErrorCode::kResourceExhausted, "uploads in flight on this server already hold " + std::to_string(max_files_) +
+                                            " spool files (--max-spool-files); retry later");
+  }
   static std::atomic<std::uint64_t> counter{0};
   const std::string path = (path_ / ("upload-" + std::to_string(++counter) + safe_extension(file_name))).string();
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) fail(ErrorCode::kInternal, "cannot create a spool file: " + std::string(std::strerror(errno)));
-  return std::unique_ptr<SpoolFile>(new SpoolFile(path, fd));
+  if (fd < 0) {
+    const int error = errno;
+    --live_;
+    fail(ErrorCode::kInternal, "cannot create a spool file: " + std::string(std::strerror(error)));
+  }
+  return std::unique_ptr<SpoolFile>(new SpoolFile(path, fd, live_));
 }
 
 }  // namespace k4reg::service

@@ -2,11 +2,16 @@
 // clouds (paths on the server or uploads), then the uploads in chunks, spooled and checked (stream_uploads.h);
 // once every declared byte has arrived the job is queued, and its events go back on the same call.
 //
+// A call that sends no message for --upload-idle-timeout-s before its uploads are complete is cancelled
+// (upload_idle_watch.h) and ends DEADLINE_EXCEEDED naming the flag.
+//
 // Threads: reads and their reactions run on gRPC threads (appending a <= 1 MiB chunk to a spool file is
 // quick); the job runs on a worker, which posts events through the outbox (job_stream_reactor.h).
 #pragma once
 
 #include <grpcpp/support/server_callback.h>
+
+#include <fmt/format.h>
 
 #include "job_stream_reactor.h"
 #include "k4reg/util/error.h"
@@ -14,6 +19,7 @@
 #include "service_context.h"
 #include "status_mapping.h"
 #include "stream_uploads.h"
+#include "upload_idle_watch.h"
 
 namespace k4reg::service {
 
@@ -27,13 +33,20 @@ class UploadStreamReactor : public JobStreamReactor<grpc::ServerBidiReactor<Requ
 
   void OnReadDone(bool ok) override {
     if (!ok) {
-      // The client closed its side (or the call broke) before every declared byte arrived.
-      this->finish(context_->IsCancelled() ? grpc::Status::CANCELLED
-                                           : grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                                                          header_seen_ ? "stream ended before the uploads were complete"
-                                                                       : "stream ended before the header"));
+      // The client closed its side (or the call broke, or sent nothing for too long) before every declared byte
+      // arrived.
+      if (idle_.timed_out)
+        this->finish({grpc::StatusCode::DEADLINE_EXCEEDED,
+                      fmt::format("no upload message for {:g} s (--upload-idle-timeout-s)",
+                                  this->service_.idle_uploads.timeout_s())});
+      else
+        this->finish(context_->IsCancelled() ? grpc::Status::CANCELLED
+                                             : grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                                                            header_seen_ ? "stream ended before the uploads were complete"
+                                                                         : "stream ended before the header"));
       return;
     }
+    idle_.touch();
     try {
       if (!header_seen_) {
         if (!request_.has_header()) fail(ErrorCode::kInvalidArgument, "the first message must be the header");
@@ -54,10 +67,14 @@ class UploadStreamReactor : public JobStreamReactor<grpc::ServerBidiReactor<Requ
       return;
     }
     clock_.upload_end = CallClock::Clock::now();
+    this->service_.idle_uploads.unwatch(idle_);  // waiting for a worker is no idling
     this->start_job(*context_, clock_, [this](Job& job) { execute(job); });
   }
 
-  void OnDone() override { delete this; }
+  void OnDone() override {
+    this->service_.idle_uploads.unwatch(idle_);
+    delete this;
+  }
 
  protected:
   // The last step of the derived reactor's constructor: reads may call back at once, on another thread.
@@ -67,6 +84,8 @@ class UploadStreamReactor : public JobStreamReactor<grpc::ServerBidiReactor<Requ
       this->finish(status);
       return;
     }
+    idle_.context = context_;
+    this->service_.idle_uploads.watch(idle_);
     this->StartRead(&request_);
   }
 
@@ -93,6 +112,7 @@ class UploadStreamReactor : public JobStreamReactor<grpc::ServerBidiReactor<Requ
   grpc::CallbackServerContext* context_;
   Request request_;
   bool header_seen_ = false;
+  UploadIdleWatch::Call idle_;
 };
 
 }  // namespace k4reg::service

@@ -121,11 +121,14 @@ def k8s_container(d):
 
 
 def k8s_env(d):
-    """Literal values, and "<field:PATH>" for values Kubernetes fills in (valueFrom)."""
+    """Literal values, "<field:PATH>" for values Kubernetes fills in (valueFrom) and "<secret:NAME/KEY>" for Secrets."""
     env = {}
     for entry in k8s_container(d).get("env", []):
-        source = entry.get("valueFrom", {}).get("fieldRef", {}).get("fieldPath")
-        env[entry["name"]] = str(entry["value"]) if "value" in entry else f"<field:{source}>"
+        source = entry.get("valueFrom", {})
+        secret = source.get("secretKeyRef")
+        env[entry["name"]] = (str(entry["value"]) if "value" in entry else
+                              f"<secret:{secret.get('name')}/{secret.get('key')}>" if secret else
+                              f"<field:{source.get('fieldRef', {}).get('fieldPath')}>")
     return env
 
 
@@ -479,6 +482,8 @@ def check_kubernetes(d, problems):
                         f"memory limit {limits['memory']} < budget {budget} + inline requests {inline} + pair jobs "
                         f"and their kept scans {pairs} + process {PROCESS_OVERHEAD_MIB} MiB")
 
+    check_pod_isolation(problems, where, pod, container, values)
+
     security = {**pod["spec"].get("securityContext", {}), **container.get("securityContext", {})}
     problems.expect(security.get("runAsNonRoot") is True, where, "runAsNonRoot must be true")
     user = d.runtime.last("USER")
@@ -494,7 +499,55 @@ def check_kubernetes(d, problems):
             problems.expect(mounts[root].get("readOnly") is True, where, f"the data root {root} must be mounted readOnly")
 
     check_services(d, problems, labels, container, ports)
+    check_network_policy(d, problems, labels, container)
     check_scaling(d, problems, deployment, labels)
+
+
+def check_pod_isolation(problems, where, pod, container, values):
+    """No API credentials in the pod, the tokens from a Secret, the disk the spool may fill within a limit."""
+    problems.expect(pod["spec"].get("automountServiceAccountToken") is False, where,
+                    "automountServiceAccountToken must be false: the server needs no Kubernetes API credentials")
+    for name in ("K4REG_AUTH_TOKEN", "K4REG_PEER_TOKEN"):
+        problems.expect(str(values.get(name, "")).startswith("<secret:"), where,
+                        f"{name} must come from a Secret (valueFrom.secretKeyRef), never a literal in the manifest")
+    resources = container.get("resources", {})
+    requests, limits = resources.get("requests", {}), resources.get("limits", {})
+    if problems.expect("ephemeral-storage" in requests and "ephemeral-storage" in limits, where,
+                       "needs ephemeral-storage requests and limits (the upload spool)"):
+        mounts = {m["name"]: m["mountPath"] for m in container.get("volumeMounts", [])}
+        for volume in pod["spec"].get("volumes", []):
+            size = volume.get("emptyDir", {}).get("sizeLimit")
+            if size and mounts.get(volume["name"]) == values.get("K4REG_SPOOL_DIR"):
+                problems.expect(quantity(limits["ephemeral-storage"]) >= quantity(size), where,
+                                f"ephemeral-storage limit {limits['ephemeral-storage']} is below the spool volume's sizeLimit {size}")
+
+
+def check_network_policy(d, problems, labels, container):
+    """The API ports only from chosen sources (and the replicas, for pair jobs), the health port for the probes."""
+    policies = d.kind("NetworkPolicy")
+    if not problems.expect(policies, "k8s", "needs a NetworkPolicy limiting who reaches the API ports"):
+        return
+    names = {p.get("name"): p["containerPort"] for p in container.get("ports", [])}
+    for where, policy in policies:
+        spec = policy["spec"]
+        problems.expect(selects(spec.get("podSelector", {}).get("matchLabels"), labels), where,
+                        "podSelector does not match the pod labels")
+        problems.expect("Ingress" in spec.get("policyTypes", []), where, "must restrict Ingress")
+        reachable, from_everywhere, from_replicas = set(), set(), set()
+        for rule in spec.get("ingress", []):
+            ports = {names.get(p.get("port"), p.get("port")) for p in rule.get("ports", [])} or set(names.values())
+            sources = rule.get("from", [])
+            reachable |= ports
+            if not sources or any(s.get("ipBlock", {}).get("cidr") in ("0.0.0.0/0", "::/0") for s in sources):
+                from_everywhere |= ports
+            if any(selects(s.get("podSelector", {}).get("matchLabels"), labels) and "namespaceSelector" not in s
+                   for s in sources):
+                from_replicas |= ports
+        problems.expect(names.get("health") in reachable, where, "the probes must reach the health port")
+        for api in ("grpc", "http"):
+            problems.expect(names.get(api) in reachable and names.get(api) not in from_everywhere, where,
+                            f"the {api} port must be reachable from the allowed namespaces only, not from everywhere")
+        problems.expect(names.get("grpc") in from_replicas, where, "the replicas must reach each other's gRPC port (pair jobs)")
 
 
 def check_services(d, problems, labels, container, ports):

@@ -91,6 +91,16 @@ BREAKAGES = [
     ("k8s/hpa.yaml", "name: cpu", "name: memory", "must scale on CPU"),
     ("k8s/pdb.yaml", "maxUnavailable: 1", "minAvailable: 2", "block every voluntary disruption"),
     ("k8s/kustomization.yaml", "  - pdb.yaml\n", "", "resources"),
+    ("k8s/deployment.yaml", "automountServiceAccountToken: false", "automountServiceAccountToken: true",
+     "automountServiceAccountToken must be false"),
+    ("k8s/deployment.yaml", "K4REG_AUTH_TOKEN\n              valueFrom:\n                secretKeyRef:\n                  name: k4reg-token\n"
+     "                  key: auth-token", "K4REG_AUTH_TOKEN\n              value: s3cret", "K4REG_AUTH_TOKEN must come from a Secret"),
+    ("k8s/deployment.yaml", "              ephemeral-storage: 17Gi\n", "", "needs ephemeral-storage requests and limits"),
+    ("k8s/deployment.yaml", "sizeLimit: 16Gi", "sizeLimit: 32Gi", "below the spool volume's sizeLimit"),
+    ("k8s/networkpolicy.yaml", "kind: NetworkPolicy", "kind: NetworkPolicyList", "needs a NetworkPolicy"),
+    ("k8s/networkpolicy.yaml", "        - port: health", "        - port: grpc", "the grpc port must be reachable from the allowed"),
+    ("k8s/networkpolicy.yaml", "        - podSelector:\n", "        - namespaceSelector: {}\n          podSelector:\n",
+     "the replicas must reach each other's gRPC port"),
     ("k8s/pdb.yaml", "maxUnavailable: 1", "maxUnavailable: [1", "cannot read the files"),
 ]
 

@@ -2,7 +2,8 @@
 // the coordinator has the single-replica poses bit for bit and says where its pairs ran (response, metrics, the
 // peers' access logs); a peer killed with SIGKILL or drained mid-project loses nothing; a peer whose pair queue is
 // full is backpressure, not failure; replicas coordinating at once serve each other's pairs.
-// RegisterPair itself refuses bad clouds with the upload status codes and needs the bearer token.
+// RegisterPair itself refuses bad clouds with the upload status codes and needs the bearer token, or the peer token
+// where one is set. A coordinator uses no peer reply that is malformed or late.
 #include <gtest/gtest.h>
 
 #include <arpa/inet.h>
@@ -10,12 +11,14 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <csignal>
 #include <limits>
 #include <sstream>
 #include <thread>
 
 #include "k4reg/io/cloud_io.h"
+#include "peer_reply.h"
 #include "proto_convert.h"
 #include "test_support.h"
 
@@ -41,13 +44,13 @@ struct ProjectCall {
 
 // `after_first_pair` runs once the first pair event arrives; `token`, if any, is sent as the bearer token.
 ProjectCall register_project(const ServerProcess& server, const std::function<void()>& after_first_pair = {},
-                             const std::string& token = "") {
+                             const std::string& token = "", const v1::RegisterProjectRequest& request = project_request()) {
   auto stub = server.stub();
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() + std::chrono::minutes(3));
   if (!token.empty()) context.AddMetadata("authorization", "Bearer " + token);
   ProjectCall call;
-  auto reader = stub->RegisterProject(&context, project_request());
+  auto reader = stub->RegisterProject(&context, request);
   for (v1::RegisterProjectEvent event; reader->Read(&event);) {
     if (event.has_pair() && call.pairs_seen++ == 0 && after_first_pair) after_first_pair();
     if (event.has_result()) call.response = event.result();
@@ -348,6 +351,90 @@ TEST_F(PairJobs, NeedTheBearerTokenAndCoordinatorsSendIt) {
   const ProjectCall project = register_project(a, {}, "s3cret");
   ASSERT_TRUE(project.status.ok()) << project.status.error_message();
   EXPECT_EQ(project.response.pairs_on_peers(), 6u);
+}
+
+TEST_F(PairJobs, WithAPeerTokenTheClientTokenCannotSubmitThemAndCoordinatorsSendThePeerToken) {
+  ServerProcess b({"--workers", "1", "--auth-token", "client", "--peer-token", "peer"});
+  EXPECT_TRUE(has_status(call(b, request(), "client"), grpc::StatusCode::UNAUTHENTICATED, "invalid bearer token"));
+  EXPECT_TRUE(call(b, request(), "peer").ok());
+  {
+    grpc::ClientContext context;  // and the peer token is no client token
+    context.AddMetadata("authorization", "Bearer peer");
+    v1::RegisterResponse reply;
+    EXPECT_EQ(b.stub()->Register(&context, bunny_request(quick_params()), &reply).error_code(),
+              grpc::StatusCode::UNAUTHENTICATED);
+  }
+  ServerProcess a({"--data-root", bunny_dir().string(), "--workers", "1", "--auth-token", "client", "--peer-token",
+                   "peer", "--peers", peers_of({&b})});
+  const ProjectCall project = register_project(a, {}, "client");
+  ASSERT_TRUE(project.status.ok()) << project.status.error_message();
+  EXPECT_EQ(project.response.pairs_on_peers(), 6u);
+}
+
+// A peer that answers every pair it gets the points of with a result of the right shape for those clouds, but not
+// a number in its transform; or that never answers.
+class FakePeer final : public v1::Registration::Service {
+ public:
+  explicit FakePeer(bool stall) : stall_(stall) {
+    grpc::ServerBuilder builder;
+    builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port_);
+    builder.RegisterService(this);
+    server_ = builder.BuildAndStart();
+  }
+  ~FakePeer() override { server_->Shutdown(std::chrono::system_clock::now()); }
+  std::string target() const { return "ipv4:127.0.0.1:" + std::to_string(port_); }
+  int calls() const { return calls_; }
+
+  grpc::Status RegisterPair(grpc::ServerContext* context, const v1::RegisterPairRequest* request,
+                            v1::RegisterPairResponse* reply) override {
+    ++calls_;
+    while (stall_ && !context->IsCancelled()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (request->source().points_xyz().empty()) return {grpc::StatusCode::NOT_FOUND, "send the points"};
+    v1::RegistrationResult& result = *reply->mutable_result();
+    result.set_source_points(request->source().points_xyz().size() / 12);
+    result.set_target_points(request->target().points_xyz().size() / 12);
+    for (int i = 0; i < 16; ++i) result.add_transform(std::numeric_limits<double>::quiet_NaN());
+    return grpc::Status::OK;
+  }
+
+ private:
+  const bool stall_;
+  std::atomic<int> calls_{0};
+  int port_ = 0;
+  std::unique_ptr<grpc::Server> server_;
+};
+
+TEST(PeerReplies, AreUsedOnlyWhenTheyAnswerThePairAskedWithARigidFiniteTransform) {
+  v1::RegisterPairResponse reply;
+  EXPECT_EQ(service::reply_problem(reply, 10, 20), "no result");
+  v1::RegistrationResult& result = *reply.mutable_result();
+  result.set_source_points(10);
+  result.set_target_points(20);
+  for (const double value : {1, 0, 0, 5, 0, 0, -1, 2, 0, 1, 0, 3, 0, 0, 0, 1}) result.add_transform(value);
+  EXPECT_EQ(service::reply_problem(reply, 10, 20), "");
+  EXPECT_NE(service::reply_problem(reply, 20, 10).find("not the 20 and 10 sent"), std::string::npos);
+  result.set_transform(0, 2);  // a scale
+  EXPECT_EQ(service::reply_problem(reply, 10, 20), "a transform that is not rigid");
+  result.set_transform(0, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(service::reply_problem(reply, 10, 20), "a NaN or infinite number");
+  result.mutable_transform()->RemoveLast();
+  EXPECT_EQ(service::reply_problem(reply, 10, 20), "a transform of 15 numbers, not 16");
+}
+
+TEST(PeerReplies, ACoordinatorRegistersThePairsItselfWhenAPeerAnswersNonsenseOrNothing) {
+  for (const bool stall : {false, true}) {
+    FakePeer peer(stall);
+    std::vector<std::string> args{"--data-root", bunny_dir().string(), "--workers", "1", "--peers", peer.target()};
+    if (stall) args.insert(args.end(), {"--peer-timeout-s", "0.5"});
+    ServerProcess a(args);
+    v1::RegisterProjectRequest two_scans = project_request();
+    two_scans.mutable_scans()->DeleteSubrange(2, 2);
+    const ProjectCall project = register_project(a, {}, "", two_scans);
+    ASSERT_TRUE(project.status.ok()) << project.status.error_message();
+    EXPECT_EQ(project.response.pairs_on_peers(), 0u) << (stall ? "stalled" : "malformed");
+    EXPECT_EQ(project.response.pairs_local(), 1u);
+    EXPECT_GT(peer.calls(), 0);
+  }
 }
 
 }  // namespace

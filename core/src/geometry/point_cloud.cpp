@@ -34,7 +34,12 @@ PointCloud make_local_cloud(const std::vector<Eigen::Vector3d>& points_world, st
   if (cloud.origin_m.cwiseAbs().maxCoeff() < 1e4) cloud.origin_m.setZero();  // near the origin: keep the file's frame
   cloud.points.resize(points_world.size());
   for (std::size_t i = 0; i < points_world.size(); ++i) cloud.points[i] = (points_world[i] - cloud.origin_m).cast<float>();
-  if (intensity.size() == points_world.size()) cloud.intensity = std::move(intensity);
+  if (intensity.size() != points_world.size()) return cloud;
+  // A NaN would reach the intensity signal's log and the medians' nth_element (undefined with NaN).
+  for (std::size_t i = 0; i < intensity.size(); ++i)
+    if (!std::isfinite(intensity[i]))
+      fail(ErrorCode::kInvalidArgument, std::string(what) + ": point " + std::to_string(i) + " has a NaN/Inf intensity");
+  cloud.intensity = std::move(intensity);
   return cloud;
 }
 

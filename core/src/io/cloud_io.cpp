@@ -101,6 +101,7 @@ void check_point_budget(std::uint64_t count, const ReadOptions& options, const s
   if (options.max_points != 0 && count > options.max_points)
     fail_io(ErrorCode::kResourceExhausted, name,
             std::to_string(count) + " points exceed the limit of " + std::to_string(options.max_points));
+  declare_points(count);
 }
 
 PointCloud finish_cloud(std::vector<Eigen::Vector3d>&& points, std::vector<float>&& intensity,

@@ -488,7 +488,10 @@ PointCloud read_e57_bytes(std::string_view data, const std::string& name, const 
     records += scans.back().record_count;
     every_record_is_a_point &= scans.back().invalid_state < 0;
   }
-  if (every_record_is_a_point) io_detail::check_point_budget(records, options, name);
+  if (every_record_is_a_point)
+    io_detail::check_point_budget(records, options, name);
+  else
+    io_detail::declare_points(records);  // records with an invalid state are no points
   // Each scan's records must come from its own bytes: scans sharing a section would multiply a small file.
   std::vector<const ScanLayout*> by_offset;
   for (const ScanLayout& scan : scans) by_offset.push_back(&scan);

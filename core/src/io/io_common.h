@@ -42,8 +42,11 @@ class MappedFile {
   std::size_t size_ = 0;
 };
 
-// Refuses `count` points over options.max_points (kResourceExhausted).
+// Refuses `count` points over options.max_points (kResourceExhausted), then declares them (declare_points). Readers
+// call it once they know their count and before they allocate for the points.
 void check_point_budget(std::uint64_t count, const ReadOptions& options, const std::string& name);
+// `most` points will be read: where declared_points() (declared_points.h) runs the reader, it stops here.
+void declare_points(std::uint64_t most);
 
 // Builds the cloud from world coordinates: refuses an empty list ("no points"), checks every coordinate is
 // finite (naming the point) and shifts to a local origin via make_local_cloud.
