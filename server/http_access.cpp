@@ -30,8 +30,8 @@ grpc::Status check_method(const httplib::Request& request) {
           request.method + " is not served by the HTTP listener (HTTP/2 and gRPC are on --grpc-listen)"};
 }
 
-grpc::Status check_same_origin(const ServiceContext& service, const httplib::Request& request) {
-  if (!service.auth_token.empty() || request.method == "GET" || request.method == "HEAD" ||
+grpc::Status check_same_origin(const std::string& auth_token, const httplib::Request& request) {
+  if (!auth_token.empty() || request.method == "GET" || request.method == "HEAD" ||
       request.method == "OPTIONS" || !request.has_header("Origin"))
     return grpc::Status::OK;
   const std::string origin = request.get_header_value("Origin");

@@ -14,9 +14,10 @@ namespace k4reg::service {
 // UNIMPLEMENTED (405) for CONNECT, TRACE and PRI: cpp-httplib would read a PRI body whole into memory.
 grpc::Status check_method(const httplib::Request& request);
 
-// Without --auth-token, PERMISSION_DENIED (403) for a POST, PUT, PATCH or DELETE whose Origin header is not
-// this server as the client addressed it (the Host header). Requests without Origin (curl, clients) pass.
-grpc::Status check_same_origin(const ServiceContext& service, const httplib::Request& request);
+// Without a token (`auth_token` empty), PERMISSION_DENIED (403) for a POST, PUT, PATCH or DELETE whose Origin
+// header is not this server as the client addressed it (the Host header). Requests without Origin (curl,
+// clients) pass.
+grpc::Status check_same_origin(const std::string& auth_token, const httplib::Request& request);
 
 // /metrics and /v1/version: UNAUTHENTICATED without the token where one is set, unless --public-metrics.
 grpc::Status check_metrics_access(const ServiceContext& service, const httplib::Request& request);

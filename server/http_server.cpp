@@ -159,9 +159,11 @@ void HttpServer::unmatched(const httplib::Request& request, httplib::Response& r
 int HttpServer::expect_continue(const httplib::Request& request, httplib::Response& response) {
   const HttpRoute* route = find_route(request.method, request.path);
   std::string allowed;
-  const grpc::Status status = !route                 ? unmatched_status(request, allowed)
-                              : route->check_headers ? route->check_headers(service_, request)
-                                                     : grpc::Status::OK;
+  grpc::Status status = head_refusal(request);
+  if (status.ok())
+    status = !route                 ? unmatched_status(request, allowed)
+             : route->check_headers ? route->check_headers(service_, request)
+                                    : grpc::Status::OK;
   if (status.ok()) return 100;
   HttpExchange exchange(service_, request, response, route ? route_name(*route) : kUnmatchedRoute, nullptr, stopping_);
   exchange.fail(status);
@@ -190,10 +192,15 @@ httplib::Server::HandlerResponse HttpServer::protocol_error(const httplib::Reque
   return httplib::Server::HandlerResponse::Handled;
 }
 
+grpc::Status HttpServer::head_refusal(const httplib::Request& request) const {
+  grpc::Status status = check_method(request);
+  if (status.ok()) status = check_same_origin(service_.auth_token, request);
+  return status;
+}
+
 httplib::Server::HandlerResponse HttpServer::pre_route(const httplib::Request& request, httplib::Response& response) {
   if (BoundedSocketStream* stream = BoundedSocketStream::current()) stream->head_complete();
-  grpc::Status status = check_method(request);
-  if (status.ok()) status = check_same_origin(service_, request);
+  const grpc::Status status = head_refusal(request);
   if (status.ok()) return httplib::Server::HandlerResponse::Unhandled;
   const HttpRoute* route = find_route(request.method, request.path);
   HttpExchange exchange(service_, request, response, route ? route_name(*route) : kUnmatchedRoute, nullptr, stopping_);

@@ -51,7 +51,9 @@ class HttpServer {
   // Answers cpp-httplib produced itself (malformed request line or headers, a head over the listener's
   // budget): the same JSON errors and log.
   httplib::Server::HandlerResponse protocol_error(const httplib::Request& request, httplib::Response& response);
-  // Before any route and any body: the served methods and the same-origin rule (http_access.h).
+  // The served methods and the same-origin rule (http_access.h): checked before any route and any body, and
+  // before "100 Continue".
+  grpc::Status head_refusal(const httplib::Request& request) const;
   httplib::Server::HandlerResponse pre_route(const httplib::Request& request, httplib::Response& response);
   // What escaped a handler: a JSON 500 (or the error's own status), and the connection closes.
   void exception(const httplib::Request& request, httplib::Response& response, std::exception_ptr error);

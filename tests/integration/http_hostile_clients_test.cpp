@@ -223,6 +223,10 @@ TEST(HttpOpenRoutes, WithoutATokenCrossOriginPostsAre403) {
   EXPECT_EQ(foreign.status, 403) << foreign.body;
   EXPECT_NE(foreign.body.find("--auth-token"), std::string::npos) << foreign.body;
   EXPECT_EQ(curl({"-H", "Origin: null", "--data", "{}", url}).status, 403);
+  // Refused before "100 Continue": the body is never sent.
+  EXPECT_EQ(curl({"-H", "Origin: http://evil.example", "-H", "Expect: 100-continue", "-F", "source=@/dev/null", url})
+                .status,
+            403);
   // The server's own page (same origin) and clients without Origin get through to the usual checks.
   EXPECT_EQ(curl({"-H", "Origin: http://" + host, "-H", "Content-Type: application/json", "--data", "{}", url}).status,
             400);
