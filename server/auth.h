@@ -1,6 +1,6 @@
-// Optional shared-secret bearer token ("authorization: Bearer <token>" gRPC metadata or HTTP header). Only the
-// registration calls check it: the health service stays open so that probes (kubelet, load balancers) need no secret,
-// and reflection reveals only the public API.
+// Optional shared-secret bearer token ("authorization: Bearer <token>" gRPC metadata or HTTP header). The
+// registration calls and, unless --public-metrics, HTTP /metrics and /v1/version check it: the health service
+// stays open so that probes (kubelet, load balancers) need no secret; reflection is off unless --reflection.
 #pragma once
 
 #include <grpcpp/server_context.h>

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 
+#include "http_connection.h"
 #include "k4reg/util/error.h"
 
 namespace k4reg::service {
@@ -19,8 +20,8 @@ bool contains_case_insensitive(std::string_view text, std::string_view word) {
 }  // namespace
 
 RequestBody::RequestBody(const httplib::Request& request, const httplib::ContentReader* content,
-                         const std::atomic<bool>& stopping)
-    : content_(content), stopping_(stopping) {
+                         const std::atomic<bool>& stopping, std::uint64_t max_body_bytes)
+    : content_(content), stopping_(stopping), max_body_bytes_(max_body_bytes) {
   const bool chunked = contains_case_insensitive(request.get_header_value("Transfer-Encoding"), "chunked");
   if (!chunked && request.has_header("Content-Length"))
     declared_bytes_ = request.get_header_value<std::uint64_t>("Content-Length");
@@ -44,12 +45,24 @@ void RequestBody::read(const std::function<void(std::string_view)>& receive,
   if (read_) fail(ErrorCode::kInternal, "the request body was read twice");
   read_ = true;
   if (!has_body_) return;
-  const auto refuse = [this] {
+  if (declared_bytes_ > max_body_bytes_)
+    fail(ErrorCode::kResourceExhausted,
+         fmt::format("request body of {} bytes, over the HTTP listener's limit of {} bytes (from --max-upload-mb and "
+                     "--max-inline-mb)",
+                     *declared_bytes_, max_body_bytes_));
+  BoundedSocketStream* connection = BoundedSocketStream::current();
+  const auto refuse = [this, connection] {
     error_ = std::current_exception();
     discard_until_ = std::chrono::steady_clock::now() + kDiscardTime;
+    if (connection) connection->discarding();
   };
+  if (discarding_ && connection) connection->discarding();
+  // Plaintext connections bound what the multipart parser holds back (BoundedSocketStream); TLS ones cannot.
+  BoundedSocketStream* stream = multipart_ ? connection : nullptr;
+  if (stream) stream->limit_unhanded(kMaxFormFramingBytes);
   const auto on_bytes = [&](const char* data, std::size_t size) {
     bytes_received_ += size;
+    if (stream) stream->handed_on(size);
     if (!keep_reading()) return false;
     if (error_ || discarding_) return true;
     try {
@@ -75,6 +88,11 @@ void RequestBody::read(const std::function<void(std::string_view)>& receive,
                                 : (*content_)(on_bytes);
   complete_ = ended;
   if (error_) std::rethrow_exception(error_);
+  if (stream && stream->over_unhanded_limit())
+    fail(ErrorCode::kResourceExhausted,
+         fmt::format("multipart/form-data body with more than {} bytes besides its parts' contents (delimiters, part "
+                     "headers, anything after the closing delimiter)",
+                     kMaxFormFramingBytes));
   if (interrupted_) fail(ErrorCode::kCancelled, "the server is shutting down");
   if (!ended)
     fail(ErrorCode::kInvalidArgument, multipart_ ? "malformed or incomplete multipart/form-data body"

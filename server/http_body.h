@@ -5,7 +5,8 @@
 // a keep-alive connection starts at a request line and the client, still sending, reads the answer instead
 // of a connection reset: after a refusal (too large, malformed, unauthorised, ...) the rest is read and
 // discarded, for at most kDiscardTime. A body that did not end by then (or broke off) is not complete(): the
-// answer then closes the connection.
+// answer then closes the connection. A body declared larger than the listener's payload limit is never read
+// (cpp-httplib would skip it whole, with no deadline): its connection closes after the answer.
 #pragma once
 
 #include "http_lib.h"
@@ -24,11 +25,14 @@ namespace k4reg::service {
 class RequestBody {
  public:
   // How long a refused body is read and discarded (as nginx's lingering_time). Loopback drains ~1 GB/s.
-  static constexpr std::chrono::seconds kDiscardTime{30};
+  static constexpr std::chrono::seconds kDiscardTime{10};
+  // What a multipart body may carry besides its parts' contents: delimiters and part headers.
+  static constexpr std::uint64_t kMaxFormFramingBytes = 1 << 20;
 
   // `content` is null for requests without a body reader (GET). Reading stops, and the body is not complete,
-  // once `stopping` is set (the server shuts down).
-  RequestBody(const httplib::Request& request, const httplib::ContentReader* content, const std::atomic<bool>& stopping);
+  // once `stopping` is set (the server shuts down). `max_body_bytes`: the listener's payload limit.
+  RequestBody(const httplib::Request& request, const httplib::ContentReader* content, const std::atomic<bool>& stopping,
+              std::uint64_t max_body_bytes);
 
   // Content-Length, nullopt for a chunked body (size unknown until it ends).
   std::optional<std::uint64_t> declared_bytes() const { return declared_bytes_; }
@@ -63,6 +67,7 @@ class RequestBody {
   const httplib::ContentReader* content_;
   const std::atomic<bool>& stopping_;
   std::optional<std::uint64_t> declared_bytes_;
+  std::uint64_t max_body_bytes_;
   bool multipart_ = false, has_body_ = false;
   bool read_ = false, discarding_ = false, complete_ = false, interrupted_ = false;
   std::uint64_t bytes_received_ = 0;

@@ -1,6 +1,7 @@
 #include "http_exchange.h"
 
 #include "http_json.h"
+#include "http_register.h"
 #include "status_mapping.h"
 
 namespace k4reg::service {
@@ -32,7 +33,10 @@ void close_after_answer(httplib::Response& response) {
 
 HttpExchange::HttpExchange(const ServiceContext& service, const httplib::Request& request, httplib::Response& response,
                            std::string route, const httplib::ContentReader* content, const std::atomic<bool>& stopping)
-    : request(request), response(response), body(request, content, stopping), service_(service) {
+    : request(request),
+      response(response),
+      body(request, content, stopping, largest_body_limit(service)),
+      service_(service) {
   record.protocol = "http";
   record.method = std::move(route);
   record.peer = peer_of(request);
@@ -82,7 +86,9 @@ void HttpExchange::stream(const char* content_type, std::function<bool(std::stri
 }
 
 void HttpExchange::end() {
+  const int status = response.status;
   body.discard_rest();
+  response.status = status;  // cpp-httplib sets 400 on the response when the body it reads breaks off
   if (!body.complete()) close_after_answer(response);
   if (body.is_multipart()) record.upload_bytes = body.bytes_received();  // uploaded clouds, as for RegisterStream
   record.http_status = response.status;

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <future>
 #include <memory>
 
@@ -33,15 +34,21 @@ BodyKind body_kind(const httplib::Request& request) {
 
 // Pairs: two files; projects: at most kMaxProjectUploads files' worth of --max-upload-mb in one body.
 constexpr std::uint64_t kMaxProjectUploads = 64;
-std::uint64_t multipart_limit(const ServiceContext& service, const httplib::Request& request) {
-  const std::uint64_t files = request.path == "/v1/register-project" ? kMaxProjectUploads : 2;
+std::uint64_t multipart_limit(const ServiceContext& service, std::uint64_t files) {
   return files * service.max_upload_bytes + kFormOverheadBytes;
+}
+std::uint64_t multipart_limit(const ServiceContext& service, const httplib::Request& request) {
+  return multipart_limit(service, request.path == "/v1/register-project" ? kMaxProjectUploads : 2);
 }
 
 }  // namespace
 
 std::uint64_t json_body_limit(const ServiceContext& service) {
   return (service.max_inline_bytes + 2) / 3 * 4 + kJsonOverheadBytes;
+}
+
+std::uint64_t largest_body_limit(const ServiceContext& service) {
+  return std::max(json_body_limit(service), multipart_limit(service, kMaxProjectUploads));
 }
 
 grpc::Status run_and_wait(const ServiceContext& service, CallClock& clock, const std::function<grpc::Status(Job&)>& work,

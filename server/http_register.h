@@ -26,6 +26,9 @@ void handle_register(const ServiceContext& service, HttpExchange& exchange);
 // around them.
 std::uint64_t json_body_limit(const ServiceContext& service);
 
+// The largest body any route takes (a project's multipart upload): the HTTP listener's payload limit.
+std::uint64_t largest_body_limit(const ServiceContext& service);
+
 // Queues `work` like the RPCs queue their jobs and waits for it on this (cpp-httplib) thread. `queue_full`
 // tells a full queue (429) from the other RESOURCE_EXHAUSTED refusals (413).
 grpc::Status run_and_wait(const ServiceContext& service, CallClock& clock, const std::function<grpc::Status(Job&)>& work,

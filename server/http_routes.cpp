@@ -1,6 +1,7 @@
 #include "http_routes.h"
 
 #include "grpc/health/v1/health.pb.h"
+#include "http_access.h"
 #include "http_json.h"
 #include "http_register.h"
 #include "http_register_project.h"
@@ -29,12 +30,23 @@ void handle_readyz(const ServiceContext& service, HttpExchange& exchange) {
   exchange.reply(serving());
 }
 
-void handle_version(const ServiceContext& service, HttpExchange& exchange) { exchange.reply(service.server_info); }
+// Answers the refusal where check_metrics_access refuses; true then.
+bool refused_without_metrics_access(const ServiceContext& service, HttpExchange& exchange) {
+  const grpc::Status status = check_metrics_access(service, exchange.request);
+  if (!status.ok()) exchange.fail(status);
+  return !status.ok();
+}
+
+void handle_version(const ServiceContext& service, HttpExchange& exchange) {
+  if (refused_without_metrics_access(service, exchange)) return;
+  exchange.reply(service.server_info);
+}
 
 // The QA page (web/): upload scans, watch the job, look at the result. Open like the API description: it is
 // the same for everyone and holds no data; registering through it needs the token where one is set.
 void handle_page(const ServiceContext&, HttpExchange& exchange) {
   exchange.reply(200, web::render_page(nullptr), "text/html; charset=utf-8");
+  add_page_headers(exchange.response);
 }
 
 void handle_openapi(const ServiceContext&, HttpExchange& exchange) {
@@ -42,6 +54,7 @@ void handle_openapi(const ServiceContext&, HttpExchange& exchange) {
 }
 
 void handle_metrics(const ServiceContext& service, HttpExchange& exchange) {
+  if (refused_without_metrics_access(service, exchange)) return;
   Metrics::Snapshot snapshot;
   snapshot.queue_depth = service.queue.waiting();
   snapshot.queue_capacity = service.queue.capacity();

@@ -3,12 +3,15 @@
 //
 // Threads: cpp-httplib serves each connection on one thread of a fixed pool, and a registration holds its
 // thread while its job waits and runs. The pool has a thread for every job the queue can admit (workers +
-// --queue-size) plus spares for probes, metrics and quick refusals; further connections wait for a thread.
+// --queue-size) plus spares for probes, metrics, quick refusals and slow clients; further connections wait for
+// a thread. A plaintext request's head is bounded in size, field count and time (http_connection.h), its body
+// by the routes' limits (the payload limit is the largest of them), each pause by the read timeout.
 #pragma once
 
 #include "http_lib.h"
 
 #include <atomic>
+#include <exception>
 #include <memory>
 #include <optional>
 #include <string>
@@ -45,8 +48,15 @@ class HttpServer {
   // "Expect: 100-continue": refuses what the headers already tell (401, 404, 413, 503, ...) before the client
   // sends the body.
   int expect_continue(const httplib::Request& request, httplib::Response& response);
-  // Answers cpp-httplib produced itself (malformed request line or headers): the same JSON errors and log.
+  // Answers cpp-httplib produced itself (malformed request line or headers, a head over the listener's
+  // budget): the same JSON errors and log.
   httplib::Server::HandlerResponse protocol_error(const httplib::Request& request, httplib::Response& response);
+  // The served methods and the same-origin rule (http_access.h): checked before any route and any body, and
+  // before "100 Continue".
+  grpc::Status head_refusal(const httplib::Request& request) const;
+  httplib::Server::HandlerResponse pre_route(const httplib::Request& request, httplib::Response& response);
+  // What escaped a handler: a JSON 500 (or the error's own status), and the connection closes.
+  void exception(const httplib::Request& request, httplib::Response& response, std::exception_ptr error);
 
   const ServiceContext& service_;
   std::atomic<bool> stopping_{false};

@@ -78,8 +78,11 @@ UploadForm read_upload_form(RequestBody& body, const ServiceContext& service, Fo
   SpoolFile* file = nullptr;    // the part being received, if it is a file
   std::string* text = nullptr;  // the part being received, if it is a path or a parameter
   std::string part_name;
+  std::size_t parts = 0;
 
   const auto begin = [&](const httplib::MultipartFormData& part) {
+    if (++parts > kMaxFormParts)
+      fail(ErrorCode::kResourceExhausted, fmt::format("more than {} form parts (the HTTP API's limit)", kMaxFormParts));
     part_name = part.name;
     file = nullptr;
     text = nullptr;

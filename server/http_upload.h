@@ -31,10 +31,12 @@ struct UploadForm {
 
 // Longest parameter or path part.
 inline constexpr std::size_t kMaxFormFieldBytes = 4096;
+// Parts of one form: a project's scans (each a file or a path) and the parameters, with room to spare.
+inline constexpr std::size_t kMaxFormParts = 256;
 
 // Reads the whole form. Throws k4reg::Error: kInvalidArgument (a missing or repeated part, an unknown or
-// malformed parameter), kResourceExhausted (a file over --max-upload-mb, a field over kMaxFormFieldBytes, a
-// full disk), and the path errors of PathPolicy::resolve. Spool files are deleted with the form.
+// malformed parameter), kResourceExhausted (a file over --max-upload-mb, a field over kMaxFormFieldBytes, more
+// than kMaxFormParts parts, a full disk), and the path errors of PathPolicy::resolve. Spool files are deleted with the form.
 UploadForm read_upload_form(RequestBody& body, const ServiceContext& service, FormKind kind);
 
 }  // namespace k4reg::service

@@ -1,5 +1,5 @@
 // k4reg-server: the k4reg.v1.Registration gRPC service (see proto/k4reg/v1/registration.proto), with
-// grpc.health.v1 health and server reflection, and the same API over HTTP/JSON with /metrics (http_server.h);
+// grpc.health.v1 health and (with --reflection) server reflection, and the same API over HTTP/JSON with /metrics (http_server.h);
 // TLS on both (tls.h); optionally a plaintext health-only listener for probes (health_listener.h).
 // Configuration: server_config.h (flags or K4REG_* variables).
 //
@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "grpc_reflection.h"
 #include "health.h"
 #include "health_listener.h"
 #include "http_server.h"
@@ -34,6 +35,12 @@ int milliseconds(double seconds) { return static_cast<int>(std::min(seconds * 10
 
 void set_connection_options(grpc::ServerBuilder& builder, const ServerConfig& config) {
   // The largest message is a peer's pair job (--max-pair-mb); Register and RegisterProject check --max-inline-mb.
+  // What grpc++ 1.51 offers per method, measured: nothing. It has one receive limit per server (this one); a
+  // service config's maxRequestMessageBytes among the server's channel arguments is not applied to its calls;
+  // a handler, and so the token check, runs only once the whole message has arrived; an AuthMetadataProcessor
+  // (which could refuse from the metadata) is refused on insecure credentials. So a call without the token may
+  // hold up to this limit until its message is parsed; deployments keep the API ports to their clients
+  // (docker/k8s NetworkPolicy) and size --max-pair-mb to their pairs.
   const double limit_mb = std::max(static_cast<double>(config.max_inline_mb), config.max_pair_mb);
   builder.SetMaxReceiveMessageSize(static_cast<int>(limit_mb * (1 << 20)) + (64 << 10));
   builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, milliseconds(config.keepalive_time_s));
@@ -86,7 +93,8 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
                          PeerOptions{.in_flight = config.peer_in_flight,
                                      .max_pair_bytes = static_cast<std::uint64_t>(config.max_pair_mb * (1 << 20)),
                                      .call_timeout_s = config.peer_timeout_s,
-                                     .token = config.peer_token}};
+                                     .token = config.peer_token},
+                         config.public_metrics};
   RegistrationService service(context);
   std::unique_ptr<HttpServer> http;
   if (!config.http_listen.empty()) http = std::make_unique<HttpServer>(context, config.http_listen, tls);
@@ -95,8 +103,9 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
   // Before the reflection plugin: the health listener's gRPC server must carry the health service only.
   std::unique_ptr<HealthListener> probes;
   if (!config.health_listen.empty()) probes = std::make_unique<HealthListener>(context, config.health_listen);
-  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();  // links the plugin in; it registers itself
   grpc::ServerBuilder builder;
+  if (!config.reflection) builder.SetOption(without_reflection());
   int port = 0;
   builder.AddListeningPort(config.grpc_listen, grpc_credentials(tls), &port);
   builder.RegisterService(&service);

@@ -85,6 +85,11 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--auth-token", c.auth_token, "require 'authorization: Bearer TOKEN' (health stays open)")
       ->envname("K4REG_AUTH_TOKEN");
+  app.add_flag("--public-metrics", c.public_metrics,
+               "serve HTTP /metrics and /v1/version without the token (otherwise they need it where one is set)")
+      ->envname("K4REG_PUBLIC_METRICS");
+  app.add_flag("--reflection", c.reflection, "enable gRPC server reflection (off: the API is in the .proto files)")
+      ->envname("K4REG_REFLECTION");
   auto* cert = app.add_option("--tls-cert", c.tls_cert, "PEM certificate chain (enables TLS on gRPC and HTTP)")
                    ->envname("K4REG_TLS_CERT")
                    ->check(CLI::ExistingFile);
@@ -184,6 +189,8 @@ nlohmann::json config_to_json(const ServerConfig& c) {
           {"spool_dir", c.spool_dir},
           {"drain_grace_s", c.drain_grace_s},
           {"auth", !c.auth_token.empty()},
+          {"public_metrics", c.public_metrics},
+          {"reflection", c.reflection},
           {"tls", !c.tls_cert.empty()},
           {"tls_client_ca", c.tls_client_ca},
           {"max_upload_mb", c.max_upload_mb},

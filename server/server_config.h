@@ -33,6 +33,8 @@ struct ServerConfig {
   std::string spool_dir;                      // parent of the per-process upload directory; "" = system temp
   double drain_grace_s = 25.0;                // after SIGTERM, running jobs get this long before cancellation
   std::string auth_token;                     // if set, calls need "authorization: Bearer <token>"
+  bool public_metrics = false;                // /metrics and /v1/version open without the token
+  bool reflection = false;                    // gRPC server reflection (lists the API to anyone who asks)
   std::string tls_cert, tls_key;              // PEM files; both or neither; for gRPC and HTTP
   std::string tls_client_ca;                  // PEM CA file: clients must present a certificate it signed
   std::string health_listen;                  // plaintext health-only listener; "" = none

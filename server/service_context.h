@@ -58,6 +58,7 @@ struct ServiceContext {
   // k4reg-server --peers: where project pairs go (null = in process), and how.
   std::shared_ptr<grpc::Channel> peers;
   PeerOptions peer_options;
+  bool public_metrics = false;  // --public-metrics: HTTP /metrics and /v1/version need no token
   // Throws k4reg::Error(kResourceExhausted) for a Register or RegisterProject request over --max-inline-mb
   // (gRPC's own message limit is the larger --max-pair-mb, for RegisterPair).
   void check_inline_size(std::size_t bytes) const;

@@ -248,6 +248,17 @@ def health_request_seeds():
     }
 
 
+def http_header_seeds():
+    """Header fields, a blank line, then a JSON body: http_request_fuzzer.cpp splits its input there."""
+    heads = {
+        "same_origin": b"Host: 127.0.0.1:8080\r\nOrigin: http://127.0.0.1:8080\r\nAuthorization: Bearer token\r\n"
+                       b"Content-Type: application/json\r\nContent-Length: 2\r\nx-request-id: fuzz-1\r\n",
+        "odd": b"Host: a\r\nOrigin: null\r\nX-Empty:\r\nTransfer-Encoding: chunked\r\n"
+               b"Content-Length: 99999999999999999999\r\nContent-Type: multipart/form-data; boundary=\r\n",
+    }
+    return {"headers_%s.http" % name: head + b"\r\n" + b'{"source": {"path": "a.ply"}}' for name, head in heads.items()}
+
+
 def write(target, seeds):
     folder = os.path.join(CORPUS, target)  # inputs that once were findings (regress_*) stay
     os.makedirs(folder, exist_ok=True)
@@ -293,7 +304,7 @@ def main():
     write("fuzz_read_cloud_bytes", mixed)
     grpc_seeds, json_seeds = request_seeds(ply, text)
     write("fuzz_grpc_request", grpc_seeds)
-    write("fuzz_http_request", json_seeds)
+    write("fuzz_http_request", {**json_seeds, **http_header_seeds()})
     write("fuzz_health_request", health_request_seeds())
     return 0
 

@@ -177,7 +177,7 @@ TEST_F(HttpErrors, AnExhaustedTimeBudgetIs504) {
   expect_error(*server_, path_call("bun045.ply", "bun000.ply", params), 504, "DEADLINE_EXCEEDED", "time budget");
 }
 
-TEST(HttpAuth, RegistrationNeedsTheBearerTokenButProbesDoNot) {
+TEST(HttpAuth, RegistrationMetricsAndVersionNeedTheBearerTokenButProbesDoNot) {
   ServerProcess server({"--data-root", bunny_dir().string(), "--workers", "1", "--auth-token", "s3cret"});
   HttpCall call = path_call("bun045.ply", "bun000.ply");
   expect_error(server, call, 401, "UNAUTHENTICATED", "authorization");
@@ -189,9 +189,15 @@ TEST(HttpAuth, RegistrationNeedsTheBearerTokenButProbesDoNot) {
   call.headers = {{"Authorization", "Bearer s3cret"}};
   EXPECT_EQ(send_with_httplib(server, call).status, 200);
   EXPECT_EQ(send_with_curl(server, call).status, 200);
-  for (const char* path : {"/healthz", "/readyz", "/metrics", "/openapi.json", "/v1/version"}) {
+  for (const char* path : {"/healthz", "/readyz", "/openapi.json", "/"}) {
     EXPECT_EQ(reply_of(server.http().Get(path)).status, 200) << path;
     EXPECT_EQ(curl({server.http_url() + path}).status, 200) << path;
+  }
+  for (const char* path : {"/metrics", "/v1/version"}) {
+    const HttpReply refused = curl({server.http_url() + path});
+    EXPECT_EQ(refused.status, 401) << path;
+    EXPECT_NE(refused.body.find("--public-metrics"), std::string::npos) << refused.body;
+    EXPECT_EQ(curl({"-H", "Authorization: Bearer s3cret", server.http_url() + path}).status, 200) << path;
   }
   EXPECT_EQ(server.log().find("s3cret"), std::string::npos);
 }

@@ -38,7 +38,7 @@ def start_server(binary, data_dir, work_dir):
     log = open(os.path.join(work_dir, "server.log"), "w")
     process = subprocess.Popen([binary, "--grpc-listen", "127.0.0.1:0", "--port-file", port_file,
                                 "--http-listen", "", "--data-root", data_dir, "--workers", "1",
-                                "--spool-dir", work_dir],
+                                "--spool-dir", work_dir, "--reflection"],
                                stderr=log)
     deadline = time.monotonic() + 20
     while not os.path.exists(port_file):
