@@ -158,6 +158,8 @@ class ContainerRun:
 
 
 def same_value(logged, text):
+    if isinstance(logged, bool):  # a flag: the environment says true/false
+        return logged == (text.lower() in ("true", "1", "yes", "on"))
     try:
         return float(logged) == float(text)
     except (TypeError, ValueError):
