@@ -26,8 +26,9 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
-// The server's resident set may grow by this much while it refuses a hostile request.
-constexpr std::size_t kAllowedGrowthKib = 8 << 10;
+// The server's resident set may grow by this much while it refuses a hostile request: main grew by 72-509 MB on
+// these requests; a sanitizer build's allocator keeps freed blocks in quarantine and grows by ~11 MB on any.
+constexpr std::size_t kAllowedGrowthKib = 32 << 10;
 
 std::size_t peak_resident_kib(pid_t pid) {
   std::ifstream status("/proc/" + std::to_string(pid) + "/status");
