@@ -3,7 +3,7 @@
 //
 //   k4reg-bench-project [--part tuning|held-out|all|scaling] [--suites NAME,...] [--seeds N] [--data-dir DIR]
 //                       [--cache-dir DIR] [--results-dir DIR] [--markdown FILE] [--list]
-//                       [--frames scanner|arbitrary|mixed]
+//                       [--frames scanner|arbitrary|mixed] [--free-space auto|off]
 //
 // The scaling part (not in "all": about 15 minutes) registers the courtyard's first 6, 12 and 24 stations at 1 M
 // points, all pairs, automatic overlap (and 12 with the overlap given as 0.4), then the 24 stations, the bunny and
@@ -249,7 +249,7 @@ std::vector<Suite> all_suites(const fs::path& data, const SimulatedSource& cache
   };
 }
 
-Run run_one(const Suite& suite, std::uint64_t seed) {
+Run run_one(const Suite& suite, std::uint64_t seed, FreeSpaceCheck free_space) {
   Run run;
   run.suite = suite.name, run.part = suite.part, run.seed = seed;
   const Project project = suite.load(seed);
@@ -258,6 +258,7 @@ Run run_one(const Suite& suite, std::uint64_t seed) {
   params.pairwise.min_scale_m = suite.min_scale_m;
   params.pairwise.overlap = suite.overlap;
   params.pairwise.seed = seed;
+  params.pairwise.free_space = free_space;
   params.pairs = suite.pairs;
   const auto start = Clock::now();
   try {
@@ -378,12 +379,18 @@ int main(int argc, char** argv) {
                  "arbitrary); projects named -arb / -mix, results in project[-scaling]-FRAMES-runs.csv and the block "
                  "project[-scaling]-FRAMES")
       ->check(CLI::IsMember({"scanner", "arbitrary", "mixed"}));
+  std::string free_space = "auto";
+  app.add_option("--free-space", free_space,
+                 "auto (as a user gets it) or off (geometry alone: results in project[-scaling]-FRAMES-geometry-runs.csv "
+                 "and the block project[-scaling]-FRAMES-geometry)")
+      ->check(CLI::IsMember({"auto", "off"}));
   CLI11_PARSE(app, argc, argv);
   try {
     const SimulatedSource source{o.cache_dir, frames == "arbitrary" ? Frames::kArbitrary
                                               : frames == "mixed"   ? Frames::kMixed
                                                                     : Frames::kScanner};
-    const std::string named = frames == "scanner" ? "" : "-" + frames;
+    const bool geometry_only = free_space == "off";
+    const std::string named = (frames == "scanner" ? "" : "-" + frames) + (geometry_only ? "-geometry" : "");
     const auto suites = all_suites(o.data_dir, source);
     if (o.list) {  // before the CSV is opened: listing must not empty the last run's results
       for (const Suite& s : suites)
@@ -400,7 +407,7 @@ int main(int argc, char** argv) {
     for (const Suite& s : suites) {
       if (!o.selected(s.part, s.name)) continue;
       for (int seed = 1; seed <= o.seeds; ++seed) {
-        const Run r = run_one(s, seed);
+        const Run r = run_one(s, seed, geometry_only ? k4reg::FreeSpaceCheck::kOff : k4reg::FreeSpaceCheck::kAuto);
         runs.push_back(r);
         std::printf("%-9s %-22s seed %d: %zu/%zu correct, %zu unregistered, %zu CONFIDENT MISSES, worst %.3g m, links %zu/%zu, "
                     "loops %zu (%zu open), %.1f s%s\n",

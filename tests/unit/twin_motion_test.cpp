@@ -124,6 +124,23 @@ TEST(TwinMotion, NoLinkWithAnotherCandidateLeavesThePerLinkCutAndNoTwin) {
   }
 }
 
+TEST(TwinMotion, LinksJudgedOnGeometryAloneHoldAgainstTheirOwnBar) {
+  // Station 0's three links each won by 0.05: with the scanners' free space, three independent margins that add
+  // up to 0.15 hold scans 1-3 firmly; on geometry alone (bar kGeometryOnlyAmbiguousMargin) they add up to 0.15 of
+  // 0.2, too weak to tell the scans from a twin placement.
+  for (const bool free_space : {true, false}) {
+    HallProject hall;
+    for (LinkCandidates& c : hall.candidates) c.transforms.resize(1), c.scores.resize(1), c.free_space_used = free_space;
+    for (ProjectLink& link : hall.project.links) link.ambiguity_margin = 0.05, link.reverse_judged = false;
+    const std::vector<TwinHold> holds =
+        holds_against_twins(hall.project, hall.candidates, hall.all_links(), hall.radius_m, 1.0);
+    for (std::size_t i : {1, 2, 3}) {
+      EXPECT_NEAR(holds[i].strength, free_space ? 0.15 : 0.0375, 1e-12) << i;
+      EXPECT_EQ(holds[i].strength >= kAmbiguousMargin, free_space) << i;
+    }
+  }
+}
+
 TEST(TwinMotion, AMotionOneLinkAcrossNeverFoundIsNotATwin) {
   HallProject hall;
   // Station 0 -> 3 found none of the half turns (its runner-up a shift): no motion is offered by all three links

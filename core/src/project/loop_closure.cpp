@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "k4reg/geometry/rigid_motion.h"
+#include "k4reg/registration/ambiguity_margin.h"
 #include "k4reg/registration/registration.h"
 
 namespace k4reg {
@@ -117,7 +118,7 @@ LoopPoseJudgement judge_implied_poses(const LinkCandidates& link, const std::vec
   if (link.transforms.empty() || judged.hypotheses.empty()) return LoopPoseJudgement::kWinnerStands;
   if (implied_pose(judged.transform) && !within_loop_tolerance(link, link.transforms.front(), judged.transform, scan_radius_m))
     return LoopPoseJudgement::kImpliedWon;
-  const bool tied = judged.ambiguity_margin < kAmbiguousMargin && judged.hypotheses.size() >= 2 &&
+  const bool tied = judged.ambiguity_margin < ambiguous_below(judged.free_space_used) && judged.hypotheses.size() >= 2 &&
                     judged.hypotheses[1].refined_score > 0 && implied_pose(judged.hypotheses[1].transform);
   return tied ? LoopPoseJudgement::kTied : LoopPoseJudgement::kWinnerStands;
 }

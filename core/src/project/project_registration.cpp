@@ -16,6 +16,7 @@
 #include "k4reg/project/scan_conflicts.h"
 #include "k4reg/project/twin_motion.h"
 #include "k4reg/project/two_sided_margin.h"
+#include "k4reg/registration/ambiguity_margin.h"
 #include "k4reg/registration/translation_constraint.h"
 #include "k4reg/util/error.h"
 
@@ -155,7 +156,8 @@ LinkCandidates link_from_outcome(const PairOutcome& outcome, const ScanPair& pai
   link.transform = result.transform;
   c.tolerance_m = link_tolerance_m(link);
   c.ambiguous = result.ambiguous;
-  c.margin = result.ambiguity_margin;
+  c.margin = margin_against_free_space_bar(result.ambiguity_margin, result.free_space_used);
+  c.free_space_used = result.free_space_used;
   c.well_supported = result.well_supported;
   return c;
 }

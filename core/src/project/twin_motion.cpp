@@ -5,23 +5,18 @@
 #include <optional>
 
 #include "k4reg/geometry/rigid_motion.h"
+#include "k4reg/registration/ambiguity_margin.h"
 #include "k4reg/project/scan_strength.h"
 
 namespace k4reg {
 namespace {
 
-// (a - b) / max(a, b); 0 where neither scores.
-double side_margin(double a, double b) {
-  const double larger = std::max(a, b);
-  return larger > 0 ? (a - b) / larger : 0.0;
-}
-
 bool holds_anything(const ProjectLink& link) { return link.candidate == 0 && link.well_supported; }
 
 // The link's margin from the source's side over its best runner-up: the part a twin motion can raise.
 double forward_margin(const ProjectLink& link, const LinkCandidates& c) {
-  if (link.reverse_judged && c.scores.size() >= 2) return side_margin(c.scores[0], c.scores[1]);
-  return link.ambiguity_margin;
+  if (link.reverse_judged && c.scores.size() >= 2) return score_margin(c.scores[0], c.scores[1], c.free_space_used);
+  return margin_against_free_space_bar(link.ambiguity_margin, c.free_space_used);
 }
 
 // The weight with the source's side's margin given.
@@ -59,7 +54,7 @@ double forward_margin_against(const ProjectResult& p, const ProjectLink& link, c
   for (const bool source_moves : {true, false}) {
     const std::optional<double> score =
         score_standing_for(c, moved_link(p, link, motion, source_moves), radius_m.at(link.source));
-    smallest = std::min(smallest, score ? std::max(side_margin(c.scores[0], *score), fallback) : fallback);
+    smallest = std::min(smallest, score ? std::max(score_margin(c.scores[0], *score, c.free_space_used), fallback) : fallback);
   }
   return smallest;
 }

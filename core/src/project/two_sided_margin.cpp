@@ -5,18 +5,10 @@
 #include <utility>
 
 #include "k4reg/geometry/rigid_motion.h"
+#include "k4reg/registration/ambiguity_margin.h"
 #include "k4reg/util/error.h"
 
 namespace k4reg {
-namespace {
-
-// (a - b) / max(a, b); 0 where neither scores.
-double side_margin(double a, double b) {
-  const double larger = std::max(a, b);
-  return larger > 0 ? (a - b) / larger : 0.0;
-}
-
-}  // namespace
 
 TwoSidedJudgement judge_from_both_sides(const PreparedScan& source, const PreparedScan& target, LinkCandidates& link,
                                         const RegistrationParams& params, const std::vector<double>& scan_radius_m,
@@ -53,8 +45,8 @@ TwoSidedJudgement judge_from_both_sides(const PreparedScan& source, const Prepar
     }
   }
   if (!winner || !rival) return out;
-  const double forward = side_margin(link.scores[0], link.scores[1]);
-  double reverse = side_margin(*winner, *rival);
+  const double forward = score_margin(link.scores[0], link.scores[1], link.free_space_used);
+  double reverse = score_margin(*winner, *rival, judged.free_space_used);
   double both = forward + reverse;
   out.judged = true;
   if (both < 0 && rival_is_runner_up) {

@@ -30,9 +30,12 @@ struct LinkCandidates {
   std::vector<Eigen::Matrix4d> transforms;          // distinct candidates, the pairwise winner first; empty = failed
   double tolerance_m = 0.0;  // expected error of this link's true candidate (metres of scan displacement)
   bool ambiguous = false;    // the pairwise verdict on its winner
-  double margin = 1.0;       // the pairwise ambiguity margin of its winner
+  double margin = 1.0;       // the pairwise ambiguity margin of its winner, against the free-space bar
+                             // (margin_against_free_space_bar: ambiguity_margin.h)
   bool well_supported = true;  // its winner lies on the surface and explains what a true pose would
   std::vector<double> scores;  // per transform, its pairwise score (refined where it was refined); may be empty
+  bool free_space_used = true;  // the pair was judged with the scanners' free space; else on geometry alone, and
+                                // margins made from its scores count as margin_against_free_space_bar says
 };
 
 enum class LinkVerdict {

@@ -18,4 +18,17 @@ constexpr double ambiguous_below(bool free_space_used) {
   return free_space_used ? kAmbiguousMargin : kGeometryOnlyAmbiguousMargin;
 }
 
+// A margin as it weighs against kAmbiguousMargin: one judged on geometry alone is scaled down by
+// kAmbiguousMargin / kGeometryOnlyAmbiguousMargin, so that a project's rules (loops that vouch, two-sided margins,
+// how firmly links hold a scan: all against kAmbiguousMargin) hold a geometry-only link to its pair's bar.
+constexpr double margin_against_free_space_bar(double margin, bool free_space_used) {
+  return margin * kAmbiguousMargin / ambiguous_below(free_space_used);
+}
+
+// Score a's margin over score b, (a - b) / max(a, b) (0 where neither scores), against the free-space bar.
+constexpr double score_margin(double a, double b, bool free_space_used) {
+  const double larger = a > b ? a : b;
+  return larger > 0 ? margin_against_free_space_bar((a - b) / larger, free_space_used) : 0.0;
+}
+
 }  // namespace k4reg
