@@ -19,6 +19,7 @@
 #include "k4reg/registration/ambiguity_margin.h"
 #include "k4reg/registration/translation_constraint.h"
 #include "k4reg/util/error.h"
+#include "k4reg/util/median.h"
 
 namespace k4reg {
 namespace {
@@ -111,12 +112,6 @@ void reject(ProjectResult& r, std::size_t l, const std::string& reason) {
 double link_tolerance_m(const ProjectLink& link) { return std::max(2.0 * link.min_scale_m_used, link.rmse_m); }
 
 namespace {
-
-// The middle value (the upper of the two middle ones for an even count); values must not be empty.
-double median(std::vector<double> values) {
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
 
 // A pair's link as registered (before selection) and its candidates for the loops: the pairwise winner first.
 LinkCandidates link_from_outcome(const PairOutcome& outcome, const ScanPair& pair, ProjectLink& link) {

@@ -11,11 +11,13 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 
 #include "k4reg/geometry/hash_map.h"
 #include "k4reg/geometry/voxel_grid.h"
+#include "k4reg/util/median.h"
 
 namespace k4reg {
 
@@ -49,12 +51,6 @@ constexpr double kMinAngleRatio = 0.25;   // the cosine of 75 degrees
 // away from the scanner and 0.05-0.12 for merged, resampled or fused clouds (a Velodyne's beams, 1-2 degrees
 // apart, give 0.02: too far apart to be one step).
 constexpr double kMinScannerShare = 0.5;
-
-double median_of(std::vector<double>& values) {
-  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), mid, values.end());
-  return *mid;
-}
 
 }  // namespace
 
@@ -360,7 +356,7 @@ bool surrounded_by(const std::vector<Eigen::Vector3f>& points, const Eigen::Vect
   ranges.reserve(points.size());
   for (const Eigen::Vector3f& p : points) ranges.push_back((p - at).norm());
   constexpr double kMinScannerRange = 1.0;
-  return median_of(ranges) >= kMinScannerRange;
+  return median(std::move(ranges)) >= kMinScannerRange;
 }
 
 namespace {
