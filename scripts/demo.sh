@@ -1,9 +1,15 @@
 #!/usr/bin/env bash
-# The main job: build, simulate two scans of the lab with ground truth, register them locally and
-# print the transform and its error against the ground truth.
+# The main job: build what the demo runs, simulate two scans of the lab with ground truth, register them locally
+# and print the transform and its error against the ground truth. It installs and builds only the library, the
+# CLI (local commands) and the simulator, so a fresh machine gets its first result quickly; scripts/test.sh
+# installs and builds everything else (service, tests, benchmarks) into the same build/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/build.sh
+source scripts/compiler-cache.sh
+bash scripts/install-deps.sh --demo
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release \
+  -DK4REG_BUILD_SERVICE=OFF -DK4REG_BUILD_TESTS=OFF -DK4REG_BUILD_BENCH=OFF
+cmake --build build -j"$(nproc)" --target k4reg k4reg-simulate
 out=${K4REG_DEMO_DIR:-out/demo}
 mkdir -p "$out"
 bin=build/bin

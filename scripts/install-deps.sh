@@ -3,6 +3,8 @@
 #   install-deps.sh           everything: build, every test suite, sanitizers, fuzzing, benchmarks (CI, development)
 #   install-deps.sh --image   only what k4reg-server, k4reg and the unit tests need to compile (the image's build
 #                             stage, cmake -DK4REG_BUILD_BENCH=OFF): no PCL (VTK, Qt, MPI, a JDK), clang, prometheus
+#   install-deps.sh --demo    only what scripts/demo.sh builds (library, CLI without its remote commands, simulator):
+#                             no gRPC, no test frameworks, so a fresh machine reaches its first registration quickly
 set -euo pipefail
 
 # The image's build stage; tests/docker/deployment_check.py reads this list (and its apt closure) from here.
@@ -13,6 +15,13 @@ IMAGE_PACKAGES=(
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libcpp-httplib-dev libssl-dev
   libjs-three  # three.js r111, compiled into the QA report and the server's page (web/)
   libgtest-dev libgmock-dev
+)
+# scripts/demo.sh: cmake -DK4REG_BUILD_SERVICE=OFF -DK4REG_BUILD_TESTS=OFF -DK4REG_BUILD_BENCH=OFF.
+DEMO_PACKAGES=(
+  build-essential cmake pkg-config
+  libeigen3-dev libtbb-dev libpugixml-dev
+  libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev
+  libjs-three  # the QA report (--report) is compiled into the CLI
 )
 PACKAGES=(
   "${IMAGE_PACKAGES[@]}" git ca-certificates
@@ -26,8 +35,9 @@ PACKAGES=(
 
 case "${1:-}" in
   --image) PACKAGES=("${IMAGE_PACKAGES[@]}") ;;
+  --demo) PACKAGES=("${DEMO_PACKAGES[@]}") ;;
   "") ;;
-  *) echo "usage: $0 [--image]" >&2; exit 2 ;;
+  *) echo "usage: $0 [--image | --demo]" >&2; exit 2 ;;
 esac
 
 missing=()

@@ -40,7 +40,7 @@ LISTEN_VARIABLES = ("K4REG_GRPC_LISTEN", "K4REG_HTTP_LISTEN", "K4REG_HEALTH_LIST
 
 
 def self_signed_certificate(folder):
-    """(cert, key) for localhost and 127.0.0.1, as README's TLS section makes one."""
+    """(cert, key) for localhost and 127.0.0.1, as docs/deployment.md's TLS walk-through makes one."""
     cert, key = Path(folder) / "cert.pem", Path(folder) / "key.pem"
     subprocess.run(["openssl", "req", "-x509", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1", "-nodes",
                     "-days", "1", "-subj", "/CN=localhost", "-addext", "subjectAltName=DNS:localhost,IP:127.0.0.1",
