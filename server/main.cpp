@@ -52,8 +52,9 @@ void set_connection_options(grpc::ServerBuilder& builder, const ServerConfig& co
   // back under. Half the memory budget, at least 64 MiB: a message over it would carry a job over the budget
   // anyway (a pair's 16 bytes per point, a binary PLY's 12, become 60 in a job). Measured (tests/integration/
   // grpc_hostile_clients_test.cpp): 4 unauthenticated 150 MB messages at once took the resident set to 1.2 GB
-  // without it; 4 x 100 MB with a budget of 256 MiB peak at 340-370 MB with it (the quota is soft: reclamation
-  // runs after the read, and an admitted message is copied once more while it is parsed).
+  // without it; 4 x 100 MB with a budget of 256 MiB peak at 340-390 MiB with it (the quota is soft: reclamation
+  // runs after the read, and an admitted message is copied once more while it is parsed). A smaller receive
+  // limit alone does not bound it: with 1 MiB and no quota, the 4 x 100 MB still peaked at 405 MiB.
   grpc::ResourceQuota quota("k4reg-receive");  // the builder keeps a reference
   builder.SetResourceQuota(quota.Resize(receive_quota_bytes(config)));
   builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, milliseconds(config.keepalive_time_s));

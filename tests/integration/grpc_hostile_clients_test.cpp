@@ -34,8 +34,17 @@ constexpr std::size_t kMessageBytes = std::size_t(100) << 20;
 constexpr std::size_t kBudgetMib = 256;
 // The server's peak resident set may pass the budget by this much: its own code, gRPC's and the allocator's
 // (about 25 MB idle) and the copy of the one message admitted while it is parsed; gRPC's receive quota is half the
-// budget and soft. Measured 340-370 MiB; main, bounded only by its 1 GiB receive limit, reached 918 MiB.
-constexpr std::size_t kMarginMib = 192;
+// budget and soft. Measured 340-390 MiB; main, bounded only by its 1 GiB receive limit, reached 918 MiB.
+constexpr std::size_t kMarginMib = 256;
+// Under AddressSanitizer the server also holds freed blocks in quarantine (256 MiB by default) and shadow memory
+// (an eighth of what it maps); this allowance for them is reasoned, not measured.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr std::size_t kSanitizerMib = 320;
+#elif defined(__has_feature)
+constexpr std::size_t kSanitizerMib = __has_feature(address_sanitizer) ? 320 : 0;
+#else
+constexpr std::size_t kSanitizerMib = 0;
+#endif
 
 // A serialized RegisterRequest whose source is an inline cloud of `bytes` bytes.
 std::string large_register_request(std::size_t bytes) {
@@ -130,7 +139,7 @@ TEST(GrpcHostileClients, ConcurrentLargeUnauthenticatedMessagesStayWithinTheBudg
   const std::chrono::milliseconds worst = prober.worst();
   EXPECT_LT(worst, 1s) << worst.count() << " ms";
   const std::size_t peak_mib = peak_resident_kib(server.pid()) >> 10;
-  EXPECT_LT(peak_mib, kBudgetMib + kMarginMib);
+  EXPECT_LT(peak_mib, kBudgetMib + kMarginMib + kSanitizerMib);
   RecordProperty("peak_rss_mib", std::to_string(peak_mib));
   RecordProperty("worst_probe_ms", std::to_string(worst.count()));
   EXPECT_EQ(health_status(server, "liveness"), "SERVING");
