@@ -19,14 +19,6 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// Peak resident memory of a process (VmHWM), KiB.
-std::size_t peak_resident_kib(pid_t pid) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  for (std::string line; std::getline(status, line);)
-    if (line.rfind("VmHWM:", 0) == 0) return std::stoul(line.substr(6));
-  throw std::runtime_error("no VmHWM for pid " + std::to_string(pid));
-}
-
 // A binary_compressed PCD of `points` points at the origin: 12 bytes each unpacked, 88 times fewer as LZF (one
 // literal zero, then back references of 264 bytes at distance 1). 30 M points: 360 MB unpacked from 4 MB.
 std::string compressed_pcd(std::uint64_t points) {

@@ -30,13 +30,6 @@ using Clock = std::chrono::steady_clock;
 // these requests; a sanitizer build's allocator keeps freed blocks in quarantine and grows by ~11 MB on any.
 constexpr std::size_t kAllowedGrowthKib = 32 << 10;
 
-std::size_t peak_resident_kib(pid_t pid) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  for (std::string line; std::getline(status, line);)
-    if (line.rfind("VmHWM:", 0) == 0) return std::stoul(line.substr(6));
-  return 0;
-}
-
 // The answer's JSON error, from a raw answer ("" if it has none).
 std::string body_of(const std::string& answer) {
   const std::size_t end = answer.find("\r\n\r\n");

@@ -426,11 +426,20 @@ HttpReply curl(const std::vector<std::string>& args, const std::string& stdin_co
   return reply;
 }
 
-std::size_t resident_kib(pid_t pid) {
+namespace {
+
+// A "Field:   N kB" line of /proc/<pid>/status, KiB.
+std::size_t status_kib(pid_t pid, const std::string& field) {
   std::ifstream status("/proc/" + std::to_string(pid) + "/status");
   for (std::string line; std::getline(status, line);)
-    if (line.rfind("VmRSS:", 0) == 0) return std::stoul(line.substr(6));
-  throw std::runtime_error("no VmRSS for pid " + std::to_string(pid));
+    if (line.rfind(field + ":", 0) == 0) return std::stoul(line.substr(field.size() + 1));
+  throw std::runtime_error("no " + field + " for pid " + std::to_string(pid));
 }
+
+}  // namespace
+
+std::size_t resident_kib(pid_t pid) { return status_kib(pid, "VmRSS"); }
+
+std::size_t peak_resident_kib(pid_t pid) { return status_kib(pid, "VmHWM"); }
 
 }  // namespace k4reg::test

@@ -195,7 +195,8 @@ bool http_status_becomes(const ServerProcess& server, const std::string& path, i
 // curl's stdin (`-T -`, `-d @-`): large bodies come from a generator, never from a file.
 HttpReply curl(const std::vector<std::string>& args, const std::string& stdin_command = "");
 
-// Resident memory of a process, from /proc/<pid>/status.
+// Resident memory of a process, from /proc/<pid>/status, KiB: now (VmRSS) and its peak (VmHWM).
 std::size_t resident_kib(pid_t pid);
+std::size_t peak_resident_kib(pid_t pid);
 
 }  // namespace k4reg::test
