@@ -72,6 +72,9 @@ void PairReactor::OnCancel() {
 
 void PairReactor::finish(const grpc::Status& status) {
   if (finished_.exchange(true)) return;
+  // No job runs on the scans any more: the cache counts what the pair prepared on them, and may let them go.
+  service_.pair_scans.release(std::move(source_));
+  service_.pair_scans.release(std::move(target_));
   record_.code = status.error_code();
   record_.error = status.error_message();
   service_.metrics.pair_job_received(status_code_name(status.error_code()));

@@ -555,9 +555,11 @@ TEST_F(CloudIoTest, WrongMagicAndBadHeaders) {
                                                          "end_header\n");
   expect_error([&] { read_cloud(bad_type); }, ErrorCode::kInvalidArgument, bad_type, "line 4");
   const std::string bad_format = write_file("badformat.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n");
-  expect_error([&] { read_cloud(bad_format); }, ErrorCode::kInvalidArgument, bad_format, "binary_middle_endian");
+  expect_error([&] { read_cloud(bad_format); }, ErrorCode::kInvalidArgument, bad_format,
+               "header line 2: unknown PLY format");
   const std::string negative = write_file("negative.ply", "ply\nformat ascii 1.0\nelement vertex -5\nend_header\n");
-  expect_error([&] { read_cloud(negative); }, ErrorCode::kInvalidArgument, negative, "-5");
+  expect_error([&] { read_cloud(negative); }, ErrorCode::kInvalidArgument, negative,
+               "header line 3: the element count is not a non-negative integer");
   const std::string pcd_no_y = write_file("noy.pcd", "VERSION 0.7\nFIELDS x z\nSIZE 4 4\nTYPE F F\nWIDTH 1\nHEIGHT 1\n"
                                                      "POINTS 1\nDATA ascii\n1 2\n");
   expect_error([&] { read_cloud(pcd_no_y); }, ErrorCode::kInvalidArgument, pcd_no_y, "'y'");

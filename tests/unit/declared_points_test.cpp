@@ -56,5 +56,21 @@ TEST(DeclaredPoints, AreRefusedOverMaxPointsWhereAHeaderStatesThem) {
   EXPECT_EQ(declared_points("0 0 0\n1 0 0\n0 1 0\n", "a.xyz", ReadOptions{2}), 2u);
 }
 
+// The header pass decodes no point: a body the reader refuses still declares what its header says.
+TEST(DeclaredPoints, ComeFromTheHeaderWithoutDecodingTheBody) {
+  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                          "property float z\nend_header\na b c\nd e f\n";
+  EXPECT_EQ(declared_points(ply, "a.ply"), 2u);
+  EXPECT_THROW(read_cloud_bytes(ply, "a.ply"), Error);
+  const std::string pcd = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nPOINTS 2\nDATA ascii\na b c\nd e f\n";
+  EXPECT_EQ(declared_points(pcd, "a.pcd"), 2u);
+  EXPECT_THROW(read_cloud_bytes(pcd, "a.pcd"), Error);
+  // A header it cannot read is refused as the reader refuses it; so is a scan selection for a one-scan format.
+  EXPECT_THROW(declared_points("ply\nformat ascii 1.0\nend_header\n", "a.ply"), Error);
+  ReadOptions second;
+  second.scan_index = 1;
+  EXPECT_THROW(declared_points(ply, "a.ply", second), Error);
+}
+
 }  // namespace
 }  // namespace k4reg

@@ -155,7 +155,7 @@ TEST_F(PtxIoTest, MalformedFilesNameTheLine) {
       {"matrix.ptx", h.substr(0, h.rfind("1 2 3 1")) + "1 2 3\n1 1 1 0.5\n2 2 2 0.5\n", "line 10: scan 0 header: expected a row of the 4x4 matrix"},
       {"lastcol.ptx", h.substr(0, h.find("1 0 0 0")) + "1 0 0 5\n0 1 0 0\n0 0 1 0\n1 2 3 1\n1 1 1 1\n2 2 2 2\n", "last column"},
       {"short.ptx", h + "1 2 3 0.5                     \n", "truncated: scan 0 declares 2 points, the file ends after 1"},
-      {"garbage.ptx", h + "1 2 3 0.5\n4 x 6 0.5\n", "line 12: column 2 value 'x' is not a number"},
+      {"garbage.ptx", h + "1 2 3 0.5\n4 x 6 0.5\n", "line 12: column 2 is not a number"},
       {"columns2.ptx", h + "1 2 3 0.5\n4 5 6\n", "inconsistent columns"},
       {"five.ptx", h + "1 2 3 0.5 1\n4 5 6 0.5 1\n", "3, 4 or 7 numbers"},
       {"nan.ptx", h + "1 nan 3 0.5\n4 5 6 0.5\n", "NaN"},

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "k4reg/util/error.h"
+#include "k4reg/util/held_bytes.h"
 
 namespace k4reg {
 
@@ -69,6 +70,11 @@ NeighborGrid::NeighborGrid(const std::vector<Eigen::Vector3f>& points, double ce
     near_cells_[k] = static_cast<std::uint32_t>(entries[k]);
     near_codes_[k] = static_cast<std::uint8_t>(entries[k] >> 32);
   }
+}
+
+std::size_t NeighborGrid::bytes() const {
+  return cells_.bytes() + held_bytes(offsets_) + held_bytes(order_) + held_bytes(sorted_) + near_map_.bytes() +
+         held_bytes(near_offsets_) + held_bytes(near_cells_) + held_bytes(near_codes_);
 }
 
 }  // namespace k4reg

@@ -101,7 +101,12 @@ void check_point_budget(std::uint64_t count, const ReadOptions& options, const s
   if (options.max_points != 0 && count > options.max_points)
     fail_io(ErrorCode::kResourceExhausted, name,
             std::to_string(count) + " points exceed the limit of " + std::to_string(options.max_points));
-  declare_points(count);
+}
+
+void check_scan_selection(CloudFormat format, const std::string& name, const ReadOptions& options) {
+  if ((options.scan_index || !options.scan_name.empty()) && format != CloudFormat::kE57 && format != CloudFormat::kPtx)
+    fail_io(ErrorCode::kInvalidArgument, name,
+            std::string("a ") + to_string(format) + " file holds one scan; scan selection applies to E57 and PTX files");
 }
 
 PointCloud finish_cloud(std::vector<Eigen::Vector3d>&& points, std::vector<float>&& intensity,
@@ -159,23 +164,6 @@ void split_fields(std::string_view line, std::vector<std::string_view>& tokens) 
     while (i < n && !is_sep(line[i])) ++i;
     tokens.push_back(line.substr(start, i - start));
   }
-}
-
-std::string quote(std::string_view token) {
-  std::string out = "'";
-  std::size_t n = std::min<std::size_t>(token.size(), 40);
-  for (std::size_t i = 0; i < n; ++i) {
-    unsigned char c = static_cast<unsigned char>(token[i]);
-    if (std::isprint(c)) {
-      out += static_cast<char>(c);
-    } else {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += buf;
-    }
-  }
-  if (token.size() > n) out += "...";
-  return out + "'";
 }
 
 // ---- OutputFile ----
@@ -362,9 +350,7 @@ CloudFormat detect_format(const std::string& path) {
 
 PointCloud read_cloud_bytes(std::string_view data, const std::string& name, const ReadOptions& options) {
   const CloudFormat format = detect_format_bytes(data, name);
-  if ((options.scan_index || !options.scan_name.empty()) && format != CloudFormat::kE57 && format != CloudFormat::kPtx)
-    fail_io(ErrorCode::kInvalidArgument, name,
-            std::string("a ") + to_string(format) + " file holds one scan; scan selection applies to E57 and PTX files");
+  io_detail::check_scan_selection(format, name, options);
   switch (format) {
     case CloudFormat::kPly:
       return read_ply_bytes(data, name, options);

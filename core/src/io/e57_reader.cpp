@@ -14,6 +14,7 @@
 #include "e57_bitpack.h"
 #include "e57_format.h"
 #include "e57_pages.h"
+#include "declared_counts.h"
 #include "io_common.h"
 #include "k4reg/io/e57_io.h"
 #include "k4reg/util/error.h"
@@ -30,8 +31,7 @@ constexpr std::size_t kMaxPrototypeFields = 1024;
 
 // One /data3D entry as the XML describes it.
 struct ScanLayout {
-  std::string label;  // "scan 2 ('Station 3')" for messages
-  std::string name;
+  std::string label;  // "scan 2" for messages (never its name: that is the file's text)
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   std::uint64_t section_logical = 0, section_end = 0, data_logical = 0;  // the binary section, logical offsets
   std::uint64_t record_count = 0;
@@ -70,8 +70,7 @@ class XmlScanParser {
 
   ScanLayout parse(pugi::xml_node node, std::size_t index) {
     ScanLayout scan;
-    scan.name = text_of(node.child("name"));
-    scan.label = "scan " + std::to_string(index) + (scan.name.empty() ? "" : " (" + io_detail::quote(scan.name) + ")");
+    scan.label = "scan " + std::to_string(index);
     label_ = scan.label;
     if (const pugi::xml_node pose = node.child("pose")) parse_pose(pose, scan.pose);
     const pugi::xml_node points = node.child("points");
@@ -81,10 +80,10 @@ class XmlScanParser {
     if (!io_detail::parse_uint64(trimmed(points.attribute("fileOffset").value()), file_offset) ||
         !e57::physical_to_logical(file_offset, scan.section_logical) ||
         scan.section_logical >= pages_.logical_size())
-      fail("points fileOffset " + io_detail::quote(points.attribute("fileOffset").value()) + " is not inside the file");
+      fail("points fileOffset is not an offset inside the file");
     section_header(scan);
     if (!io_detail::parse_uint64(trimmed(points.attribute("recordCount").value()), scan.record_count))
-      fail("points recordCount " + io_detail::quote(points.attribute("recordCount").value()) + " is not a count");
+      fail("points recordCount is not a count");
     const pugi::xml_node prototype = points.child("prototype");
     if (!prototype) fail("points have no prototype");
     std::vector<std::string> names;
@@ -108,34 +107,36 @@ class XmlScanParser {
     const std::string text = text_of(node);
     double value = 0.0;
     if (type == "Float") {
-      if (!text.empty() && !io_detail::parse_double(text, value)) fail(what + " " + io_detail::quote(text) + " is not a number");
+      if (!text.empty() && !io_detail::parse_double(text, value)) fail(what + " is not a number");
     } else if (type == "Integer" || type == "ScaledInteger") {
       std::int64_t integer = 0;
-      if (!text.empty() && !parse_int64(text, integer)) fail(what + " " + io_detail::quote(text) + " is not an integer");
+      if (!text.empty() && !parse_int64(text, integer)) fail(what + " is not an integer");
       value = static_cast<double>(integer);
-      if (type == "ScaledInteger") value = value * attribute(node, "scale", 1.0) + attribute(node, "offset", 0.0);
+      if (type == "ScaledInteger")
+        value = value * attribute(node, what, "scale", 1.0) + attribute(node, what, "offset", 0.0);
     } else {
-      fail(what + " has type " + io_detail::quote(type) + ", not a number type");
+      fail(what + " is not a Float, Integer or ScaledInteger");
     }
     if (!std::isfinite(value)) fail(what + " is not finite");
     return value;
   }
 
-  double attribute(pugi::xml_node node, const char* key, double fallback) const {
+  // `what` names the node in errors: its element name may be the file's text.
+  double attribute(pugi::xml_node node, const std::string& what, const char* key, double fallback) const {
     const pugi::xml_attribute a = node.attribute(key);
     if (!a) return fallback;
     double value;
     if (!io_detail::parse_double(trimmed(a.value()), value) || !std::isfinite(value))
-      fail(io_detail::quote(node.name()) + " " + key + " " + io_detail::quote(a.value()) + " is not a finite number");
+      fail(what + " attribute " + key + " is not a finite number");
     return value;
   }
 
-  std::int64_t attribute(pugi::xml_node node, const char* key, std::int64_t fallback) const {
+  std::int64_t attribute(pugi::xml_node node, const std::string& what, const char* key, std::int64_t fallback) const {
     const pugi::xml_attribute a = node.attribute(key);
     if (!a) return fallback;
     std::int64_t value;
     if (!parse_int64(trimmed(a.value()), value))
-      fail(io_detail::quote(node.name()) + " " + key + " " + io_detail::quote(a.value()) + " is not a 64-bit integer");
+      fail(what + " attribute " + key + " is not a 64-bit integer");
     return value;
   }
 
@@ -154,13 +155,14 @@ class XmlScanParser {
     out.translation() = t;
   }
 
-  FieldCodec codec(pugi::xml_node node) const {
+  // what: "prototype field 3", the node by its position.
+  FieldCodec codec(pugi::xml_node node, const std::string& what) const {
     const std::string_view type = node.attribute("type").value();
     FieldCodec c;
     if (type == "Float") {
       const std::string_view precision = node.attribute("precision").value();
       if (precision != "" && precision != "single" && precision != "double")
-        fail(io_detail::quote(node.name()) + " precision " + io_detail::quote(precision) + " is neither single nor double");
+        fail(what + " precision is neither single nor double");
       c.single_precision = precision == "single";
       return c;
     }
@@ -169,15 +171,15 @@ class XmlScanParser {
       return c;
     }
     if (type != "Integer" && type != "ScaledInteger")
-      fail("prototype field " + io_detail::quote(node.name()) + " has unsupported type " + io_detail::quote(type));
+      fail(what + " has a type other than Float, Integer, ScaledInteger, String, Structure or Vector");
     c.type = type == "Integer" ? FieldCodec::Type::kInteger : FieldCodec::Type::kScaledInteger;
-    c.minimum = attribute(node, "minimum", std::numeric_limits<std::int64_t>::min());
-    c.maximum = attribute(node, "maximum", std::numeric_limits<std::int64_t>::max());
-    if (c.minimum > c.maximum) fail(io_detail::quote(node.name()) + " minimum is above its maximum");
+    c.minimum = attribute(node, what, "minimum", std::numeric_limits<std::int64_t>::min());
+    c.maximum = attribute(node, what, "maximum", std::numeric_limits<std::int64_t>::max());
+    if (c.minimum > c.maximum) fail(what + " minimum is above its maximum");
     if (c.type == FieldCodec::Type::kScaledInteger) {
-      c.scale = attribute(node, "scale", 1.0);
-      c.offset = attribute(node, "offset", 0.0);
-      if (c.scale == 0.0) fail(io_detail::quote(node.name()) + " scale is 0");
+      c.scale = attribute(node, what, "scale", 1.0);
+      c.offset = attribute(node, what, "offset", 0.0);
+      if (c.scale == 0.0) fail(what + " scale is 0");
     }
     return c;
   }
@@ -194,7 +196,7 @@ class XmlScanParser {
       }
       if (fields.size() >= kMaxPrototypeFields)
         fail("prototype has more than " + std::to_string(kMaxPrototypeFields) + " fields");
-      fields.push_back(codec(child));
+      fields.push_back(codec(child, "prototype field " + std::to_string(fields.size())));
       names.push_back(depth == 0 ? child.name() : "");
     }
   }
@@ -447,12 +449,20 @@ std::unique_ptr<OpenedE57> open_e57(std::string_view data, const std::string& na
   return opened;
 }
 
-}  // namespace
+// The selected scans' layouts and their records, from the XML and the sections' headers: what the file holds before
+// a record is decoded.
+struct E57Plan {
+  std::unique_ptr<OpenedE57> opened;
+  std::vector<ScanLayout> scans;
+  std::uint64_t records = 0;
+};
 
-PointCloud read_e57_bytes(std::string_view data, const std::string& name, const ReadOptions& options) {
-  const std::unique_ptr<OpenedE57> opened = open_e57(data, name);
-  e57::PagedReader& pages = opened->pages;
-  const std::vector<pugi::xml_node>& entries = opened->entries;
+// The header pass (declared_points stops here): the plan, its records checked against options.max_points where
+// each is a point (records with an invalid state are none).
+E57Plan plan_e57(std::string_view data, const std::string& name, const ReadOptions& options) {
+  E57Plan plan;
+  plan.opened = open_e57(data, name);
+  const std::vector<pugi::xml_node>& entries = plan.opened->entries;
   std::vector<std::size_t> selected;
   if (options.scan_index && !options.scan_name.empty())
     fail_io(ErrorCode::kInvalidArgument, name, "select a scan by index or by name, not both");
@@ -463,35 +473,42 @@ PointCloud read_e57_bytes(std::string_view data, const std::string& name, const 
                   std::to_string(entries.size()) + " scan" + (entries.size() == 1 ? "" : "s") + " (0-based)");
     selected.push_back(*options.scan_index);
   } else if (!options.scan_name.empty()) {
-    std::string names;
-    for (std::size_t i = 0; i < entries.size(); ++i) {
-      const std::string scan_name = text_of(entries[i].child("name"));
-      if (scan_name == options.scan_name) selected.push_back(i);
-      if (i < 20) names += (i ? ", " : "") + io_detail::quote(scan_name);
-    }
+    // The request's name may be quoted; the file's names are not listed: they are its text.
+    for (std::size_t i = 0; i < entries.size(); ++i)
+      if (text_of(entries[i].child("name")) == options.scan_name) selected.push_back(i);
     if (selected.empty())
       fail_io(ErrorCode::kInvalidArgument, name,
-              "no scan named " + io_detail::quote(options.scan_name) + " (scans: " + names + (entries.size() > 20 ? ", …)" : ")"));
+              "none of its " + std::to_string(entries.size()) + " scans is named '" + options.scan_name +
+                  "'; select one by name or by index (0-based)");
     if (selected.size() > 1)
       fail_io(ErrorCode::kInvalidArgument, name,
-              std::to_string(selected.size()) + " scans are named " + io_detail::quote(options.scan_name) + "; select one by index");
+              std::to_string(selected.size()) + " scans are named '" + options.scan_name + "'; select one by index");
   } else {
     for (std::size_t i = 0; i < entries.size(); ++i) selected.push_back(i);
   }
 
-  XmlScanParser parser(name, pages);
-  std::vector<ScanLayout> scans;
-  std::uint64_t records = 0;
+  XmlScanParser parser(name, plan.opened->pages);
   bool every_record_is_a_point = true;
   for (std::size_t i : selected) {
-    scans.push_back(parser.parse(entries[i], i));
-    records += scans.back().record_count;
-    every_record_is_a_point &= scans.back().invalid_state < 0;
+    plan.scans.push_back(parser.parse(entries[i], i));
+    plan.records += plan.scans.back().record_count;
+    every_record_is_a_point &= plan.scans.back().invalid_state < 0;
   }
-  if (every_record_is_a_point)
-    io_detail::check_point_budget(records, options, name);
-  else
-    io_detail::declare_points(records);  // records with an invalid state are no points
+  if (every_record_is_a_point) io_detail::check_point_budget(plan.records, options, name);
+  return plan;
+}
+
+}  // namespace
+
+std::uint64_t io_detail::declared_e57_points(std::string_view data, const std::string& name,
+                                             const ReadOptions& options) {
+  return plan_e57(data, name, options).records;
+}
+
+PointCloud read_e57_bytes(std::string_view data, const std::string& name, const ReadOptions& options) {
+  const E57Plan plan = plan_e57(data, name, options);
+  e57::PagedReader& pages = plan.opened->pages;
+  const std::vector<ScanLayout>& scans = plan.scans;
   // Each scan's records must come from its own bytes: scans sharing a section would multiply a small file.
   std::vector<const ScanLayout*> by_offset;
   for (const ScanLayout& scan : scans) by_offset.push_back(&scan);

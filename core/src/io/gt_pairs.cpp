@@ -26,8 +26,7 @@ std::vector<GtPair> read_gt_pairs(const std::string& path) {
     double v;
     if (!io_detail::parse_double(token, v) || !std::isfinite(v))
       fail_io(ErrorCode::kInvalidArgument, path,
-              "line " + std::to_string(lines.line_number()) + ": " + what + " " + io_detail::quote(token) +
-                  " is not a finite number");
+              "line " + std::to_string(lines.line_number()) + ": " + what + " is not a finite number");
     return v;
   };
   std::vector<GtPair> pairs;
@@ -36,7 +35,9 @@ std::vector<GtPair> read_gt_pairs(const std::string& path) {
     if (tokens.size() != 4)
       fail_io(ErrorCode::kInvalidArgument, path,
               "line " + std::to_string(lines.line_number()) +
-                  ": expected 'source target overlap inlier_rmse', found " + io_detail::quote(line));
+                  ": expected 'source target overlap inlier_rmse', found " + std::to_string(tokens.size()) +
+                  " fields");
+    const std::size_t record_line = lines.line_number();
     GtPair pair;
     pair.source = std::string(tokens[0]);
     pair.target = std::string(tokens[1]);
@@ -45,7 +46,7 @@ std::vector<GtPair> read_gt_pairs(const std::string& path) {
     for (int r = 0; r < 4; ++r) {
       if (!next_content(line))
         fail_io(ErrorCode::kInvalidArgument, path,
-                "truncated: record '" + pair.source + " " + pair.target + "' has only " + std::to_string(r) +
+                "truncated: the record of line " + std::to_string(record_line) + " has only " + std::to_string(r) +
                     " of 4 matrix rows");
       io_detail::split_fields(line, tokens);
       if (tokens.size() != 4)

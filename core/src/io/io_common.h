@@ -42,11 +42,11 @@ class MappedFile {
   std::size_t size_ = 0;
 };
 
-// Refuses `count` points over options.max_points (kResourceExhausted), then declares them (declare_points). Readers
-// call it once they know their count and before they allocate for the points.
+// Refuses `count` points over options.max_points (kResourceExhausted). Readers call it once they know their count
+// and before they allocate for the points.
 void check_point_budget(std::uint64_t count, const ReadOptions& options, const std::string& name);
-// `most` points will be read: where declared_points() (declared_points.h) runs the reader, it stops here.
-void declare_points(std::uint64_t most);
+// Refuses a scan selection (options.scan_index / scan_name) for a format that holds one scan.
+void check_scan_selection(CloudFormat format, const std::string& name, const ReadOptions& options);
 
 // Builds the cloud from world coordinates: refuses an empty list ("no points"), checks every coordinate is
 // finite (naming the point) and shifts to a local origin via make_local_cloud.
@@ -239,8 +239,5 @@ class TokenReader {
 // the caller as non-numeric), clearing `tokens` first. Stops after kMaxTokensPerLine + 1 tokens: callers refuse
 // longer lines (tokens.size() > kMaxTokensPerLine) without holding a token per byte.
 void split_fields(std::string_view line, std::vector<std::string_view>& tokens);
-
-// Quotes a token for an error message, shortened to a readable length.
-std::string quote(std::string_view token);
 
 }  // namespace k4reg::io_detail

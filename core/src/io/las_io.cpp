@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "declared_counts.h"
 #include "io_common.h"
 #include "k4reg/util/error.h"
 
@@ -113,9 +114,9 @@ LasHeader parse_header(std::string_view data, const std::string& name) {
   return h;
 }
 
-}  // namespace
-
-PointCloud read_las_bytes(std::string_view data, const std::string& name, const ReadOptions& options) {
+// The header pass (declared_points stops here): the header, its count checked against the data and
+// options.max_points; no record decoded.
+LasHeader plan_las(std::string_view data, const std::string& name, const ReadOptions& options) {
   const LasHeader h = parse_header(data, name);
   if (h.count == 0) fail_io(ErrorCode::kInvalidArgument, name, "no points");
   const std::size_t available = data.size() - h.point_offset;
@@ -125,6 +126,18 @@ PointCloud read_las_bytes(std::string_view data, const std::string& name, const 
                 std::to_string(h.record_length) + " bytes, but only " + std::to_string(available) +
                 " bytes follow the offset to point data " + std::to_string(h.point_offset));
   io_detail::check_point_budget(h.count, options, name);
+  return h;
+}
+
+}  // namespace
+
+std::uint64_t io_detail::declared_las_points(std::string_view data, const std::string& name,
+                                             const ReadOptions& options) {
+  return plan_las(data, name, options).count;
+}
+
+PointCloud read_las_bytes(std::string_view data, const std::string& name, const ReadOptions& options) {
+  const LasHeader h = plan_las(data, name, options);
   const std::size_t n = h.count;
   std::vector<Eigen::Vector3d> points(n);
   std::vector<float> intensity(n);

@@ -50,7 +50,8 @@ Eigen::Matrix4d read_matrix4(const std::string& path) {
     while (words >> token) {
       char* end = nullptr;
       const double value = std::strtod(token.c_str(), &end);
-      if (end != token.c_str() + token.size() || !std::isfinite(value)) bad("'" + token + "' is not a finite number");
+      if (end != token.c_str() + token.size() || !std::isfinite(value))
+        bad("number " + std::to_string(count + 1) + " is not a finite number");
       if (count == 16) bad("more than 16 numbers");
       m(count / 4, count % 4) = value;
       ++count;

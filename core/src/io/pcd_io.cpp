@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "declared_counts.h"
 #include "io_common.h"
 #include "k4reg/util/error.h"
 
@@ -183,7 +184,7 @@ PcdHeader parse_header(std::string_view data, const std::string& name) {
     auto one_uint = [&](std::uint64_t& v) {
       if (tok.size() != 2 || !io_detail::parse_uint64(tok[1], v))
         fail_io(ErrorCode::kInvalidArgument, name,
-                where() + std::string(key) + " needs one non-negative integer, found " + io_detail::quote(line));
+                where() + std::string(key) + " needs one non-negative integer");
     };
     if (key == "VERSION") {
       // Any version string accepted (0.5 … 0.7 share the layout we read).
@@ -220,15 +221,16 @@ PcdHeader parse_header(std::string_view data, const std::string& name) {
       } else if (tok[1] == "binary_compressed") {
         header.data = PcdData::kBinaryCompressed;
       } else {
-        fail_io(ErrorCode::kInvalidArgument, name, where() + "unknown DATA encoding " + io_detail::quote(tok[1]));
+        fail_io(ErrorCode::kInvalidArgument, name,
+                where() + "unknown DATA encoding (ascii, binary or binary_compressed are read)");
       }
       have_data = true;
       break;
     } else if (first) {
       fail_io(ErrorCode::kInvalidArgument, name,
-              "not a PCD file: wrong header (first line " + io_detail::quote(line) + ")");
+              "not a PCD file: the first header line does not start with a PCD keyword");
     } else {
-      fail_io(ErrorCode::kInvalidArgument, name, where() + "unknown header keyword " + io_detail::quote(key));
+      fail_io(ErrorCode::kInvalidArgument, name, where() + "unknown header keyword");
     }
     first = false;
   }
@@ -249,21 +251,21 @@ PcdHeader parse_header(std::string_view data, const std::string& name) {
   std::size_t offset = 0;
   for (std::size_t f = 0; f < nf; ++f) {
     PcdField& field = header.fields[f];
+    // Named by position: the field's name is the file's text.
+    const std::string field_at = "malformed header: field " + std::to_string(f + 1) + " of " + std::to_string(nf);
     std::uint64_t size = 0, count = 1;
     if (!io_detail::parse_uint64(sizes[f], size) || !(size == 1 || size == 2 || size == 4 || size == 8))
       fail_io(ErrorCode::kInvalidArgument, name,
-              "malformed header: field '" + field.name + "' has SIZE " + io_detail::quote(sizes[f]) +
-                  " (expected 1, 2, 4 or 8)");
+              field_at + " has a SIZE other than 1, 2, 4 or 8");
     if (types[f].size() != 1 || std::string_view("FIU").find(types[f][0]) == std::string_view::npos)
       fail_io(ErrorCode::kInvalidArgument, name,
-              "malformed header: field '" + field.name + "' has TYPE " + io_detail::quote(types[f]) +
-                  " (expected F, I or U)");
+              field_at + " has a TYPE other than F, I or U");
     if (types[f][0] == 'F' && size != 4 && size != 8)
       fail_io(ErrorCode::kInvalidArgument, name,
-              "malformed header: float field '" + field.name + "' has SIZE " + std::to_string(size));
+              field_at + " is a float of SIZE " + std::to_string(size) + " (expected 4 or 8)");
     if (!counts.empty() && (!io_detail::parse_uint64(counts[f], count) || count == 0 || count > (1u << 20)))
       fail_io(ErrorCode::kInvalidArgument, name,
-              "malformed header: field '" + field.name + "' has COUNT " + io_detail::quote(counts[f]));
+              field_at + " has a COUNT that is not an integer from 1 to 2^20");
     field.size = size;
     field.type = types[f][0];
     field.count = count;
@@ -461,8 +463,8 @@ PointCloud decode_binary(const char* base, const PcdHeader& header, const PcdLay
   fail_io(ErrorCode::kInvalidArgument, name, "truncated: " + what);
 }
 
-PointCloud read_ascii(std::string_view data, const PcdHeader& header, const PcdLayout& layout,
-                      const std::string& name, const ReadOptions& options) {
+// Refuses a count an ASCII body cannot hold: every value takes at least one character and one separator.
+void check_ascii_count(std::string_view data, const PcdHeader& header, const std::string& name) {
   const std::uint64_t n = header.points;
   std::size_t values_per_point = 0;
   for (const PcdField& f : header.fields) values_per_point += f.count;
@@ -471,7 +473,11 @@ PointCloud read_ascii(std::string_view data, const PcdHeader& header, const PcdL
     fail_truncated(name, "header says " + std::to_string(n) + " points of " + std::to_string(values_per_point) +
                              " values, but the " + std::to_string(remaining - 1) + "-byte body can hold at most " +
                              std::to_string(remaining / (2 * values_per_point)));
-  io_detail::check_point_budget(n, options, name);
+}
+
+PointCloud read_ascii(std::string_view data, const PcdHeader& header, const PcdLayout& layout,
+                      const std::string& name) {
+  const std::uint64_t n = header.points;
   std::vector<Eigen::Vector3d> points(n);
   std::vector<float> intensity(layout.intensity >= 0 ? n : 0);
   io_detail::TokenReader tokens(data.substr(header.body_offset), header.header_lines + 1);
@@ -486,8 +492,8 @@ PointCloud read_ascii(std::string_view data, const PcdHeader& header, const PcdL
         double v;
         if (!io_detail::parse_double(token, v))
           fail_io(ErrorCode::kInvalidArgument, name,
-                  "line " + std::to_string(tokens.line()) + ": point " + std::to_string(i) + ": field '" + field.name +
-                      "' value " + io_detail::quote(token) + " is not a number");
+                  "line " + std::to_string(tokens.line()) + ": point " + std::to_string(i) + ": the value of field " +
+                      std::to_string(f + 1) + " is not a number");
         if (c != 0) continue;
         for (int a = 0; a < 3; ++a)
           if (layout.xyz[a] == static_cast<int>(f)) points[i][a] = v;
@@ -499,27 +505,13 @@ PointCloud read_ascii(std::string_view data, const PcdHeader& header, const PcdL
   return io_detail::finish_cloud(std::move(points), std::move(intensity), name);
 }
 
-}  // namespace
-
-PointCloud read_pcd_bytes(std::string_view data, const std::string& name, const ReadOptions& options) {
-  const PcdHeader header = parse_header(data, name);
-  const PcdLayout layout = find_layout(header, name);
+// binary_compressed: uint32 compressed size, uint32 uncompressed size, LZF stream of the column-wise data. Checks
+// the sizes against the header and the file; returns the compressed size.
+std::uint64_t check_compressed_sizes(std::string_view data, const PcdHeader& header, const std::string& name) {
   const std::uint64_t n = header.points;
-  if (n == 0) fail_io(ErrorCode::kInvalidArgument, name, "no points (POINTS 0)");
-  if (header.data == PcdData::kAscii) return read_ascii(data, header, layout, name, options);
-
   const std::size_t pos = header.body_offset;
   const std::size_t remaining = data.size() - pos;
   const std::size_t stride = header.record_size;
-  if (header.data == PcdData::kBinary) {
-    if (!io_detail::mul_fits(n, stride, remaining))
-      fail_truncated(name, "header says " + std::to_string(n) + " points, data holds " + std::to_string(remaining / stride) +
-                               " (" + std::to_string(stride) + " bytes per point from byte " + std::to_string(pos) +
-                               ", file is " + std::to_string(data.size()) + " bytes)");
-    io_detail::check_point_budget(n, options, name);
-    return decode_binary(data.data() + pos, header, layout, false, name);
-  }
-  // binary_compressed: uint32 compressed size, uint32 uncompressed size, LZF stream of the column-wise data.
   if (remaining < 8)
     fail_truncated(name, "binary_compressed data needs an 8-byte size prefix, only " + std::to_string(remaining) +
                              " bytes follow the header");
@@ -537,10 +529,60 @@ PointCloud read_pcd_bytes(std::string_view data, const std::string& name, const 
   if (uncompressed > compressed * 90 + 512)
     fail_truncated(name, "binary_compressed data of " + std::to_string(compressed) + " bytes cannot hold " +
                              std::to_string(n) + " points (" + std::to_string(uncompressed) + " bytes)");
-  io_detail::check_point_budget(n, options, name);
-  const std::string raw = lzf_decompress(data.substr(pos + 8, compressed), uncompressed, name);
-  return decode_binary(raw.data(), header, layout, true, name);
+  return compressed;
 }
+
+// What the header tells before a point is decoded; for binary_compressed data, the size of its LZF stream.
+struct PcdPlan {
+  PcdHeader header;
+  PcdLayout layout;
+  std::uint64_t compressed = 0;
+};
+
+// The header pass (declared_points stops here): the plan, its count checked against the data and
+// options.max_points; nothing decompressed or decoded.
+PcdPlan plan_pcd(std::string_view data, const std::string& name, const ReadOptions& options) {
+  PcdPlan plan;
+  plan.header = parse_header(data, name);
+  const PcdHeader& header = plan.header;
+  plan.layout = find_layout(header, name);
+  const std::uint64_t n = header.points;
+  if (n == 0) fail_io(ErrorCode::kInvalidArgument, name, "no points (POINTS 0)");
+  const std::size_t pos = header.body_offset;
+  const std::size_t remaining = data.size() - pos;
+  const std::size_t stride = header.record_size;
+  if (header.data == PcdData::kAscii) {
+    check_ascii_count(data, header, name);
+  } else if (header.data == PcdData::kBinary) {
+    if (!io_detail::mul_fits(n, stride, remaining))
+      fail_truncated(name, "header says " + std::to_string(n) + " points, data holds " + std::to_string(remaining / stride) +
+                               " (" + std::to_string(stride) + " bytes per point from byte " + std::to_string(pos) +
+                               ", file is " + std::to_string(data.size()) + " bytes)");
+  } else {
+    plan.compressed = check_compressed_sizes(data, header, name);
+  }
+  io_detail::check_point_budget(n, options, name);
+  return plan;
+}
+
+}  // namespace
+
+PointCloud read_pcd_bytes(std::string_view data, const std::string& name, const ReadOptions& options) {
+  const PcdPlan plan = plan_pcd(data, name, options);
+  const PcdHeader& header = plan.header;
+  const std::size_t pos = header.body_offset;
+  if (header.data == PcdData::kAscii) return read_ascii(data, header, plan.layout, name);
+  if (header.data == PcdData::kBinary) return decode_binary(data.data() + pos, header, plan.layout, false, name);
+  const std::string raw =
+      lzf_decompress(data.substr(pos + 8, plan.compressed), header.points * header.record_size, name);
+  return decode_binary(raw.data(), header, plan.layout, true, name);
+}
+
+std::uint64_t io_detail::declared_pcd_points(std::string_view data, const std::string& name,
+                                             const ReadOptions& options) {
+  return plan_pcd(data, name, options).header.points;
+}
+
 
 PointCloud read_pcd(const std::string& path, const ReadOptions& options) {
   io_detail::MappedFile file(path);

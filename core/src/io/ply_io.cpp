@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "declared_counts.h"
 #include "io_common.h"
 #include "k4reg/util/error.h"
 
@@ -69,6 +70,7 @@ struct PlyProperty {
   PlyType type = PlyType::kFloat32;        // scalar type, or list item type
   PlyType count_type = PlyType::kUInt8;    // list count type
   std::size_t offset = 0;                  // byte offset in a fixed-size binary record (scalars only)
+  std::size_t header_line = 0;
 };
 
 struct PlyElement {
@@ -81,6 +83,14 @@ struct PlyElement {
   std::size_t min_tokens = 0;    // smallest possible ASCII record
   std::size_t header_line = 0;
 };
+
+// Errors name an element or a property by the header line declaring it, never by its name: that is the file's text.
+std::string element_at(std::size_t header_line) {
+  return "the element of header line " + std::to_string(header_line);
+}
+std::string property_at(std::size_t header_line) {
+  return "the property of header line " + std::to_string(header_line);
+}
 
 struct PlyHeader {
   PlyFormat format = PlyFormat::kAscii;
@@ -110,7 +120,7 @@ PlyHeader parse_header(std::string_view data, const std::string& name) {
   lines.next(line);
   if (line != "ply")
     fail_io(ErrorCode::kInvalidArgument, name,
-            "not a PLY file: wrong magic (expected 'ply' on the first line, found " + io_detail::quote(line) + ")");
+            "not a PLY file: wrong magic (the first line is not 'ply')");
   PlyHeader header;
   bool have_format = false, have_end = false;
   while (lines.next(line)) {
@@ -133,10 +143,11 @@ PlyHeader parse_header(std::string_view data, const std::string& name) {
       } else if (tok[1] == "binary_big_endian") {
         header.format = PlyFormat::kBinaryBigEndian;
       } else {
-        fail_io(ErrorCode::kInvalidArgument, name, where() + "unknown PLY format " + io_detail::quote(tok[1]));
+        fail_io(ErrorCode::kInvalidArgument, name,
+                where() + "unknown PLY format (ascii, binary_little_endian or binary_big_endian are read)");
       }
       if (tok[2] != "1.0" && tok[2] != "1")
-        fail_io(ErrorCode::kInvalidArgument, name, where() + "unsupported PLY version " + io_detail::quote(tok[2]));
+        fail_io(ErrorCode::kInvalidArgument, name, where() + "unsupported PLY version (1.0 is read)");
       have_format = true;
     } else if (key == "element") {
       if (tok.size() != 3) fail_io(ErrorCode::kInvalidArgument, name, where() + "malformed element line");
@@ -144,7 +155,7 @@ PlyHeader parse_header(std::string_view data, const std::string& name) {
       element.name = std::string(tok[1]);
       if (!io_detail::parse_uint64(tok[2], element.count))
         fail_io(ErrorCode::kInvalidArgument, name,
-                where() + "element count " + io_detail::quote(tok[2]) + " is not a non-negative integer");
+                where() + "the element count is not a non-negative integer");
       element.header_line = ln;
       if (header.elements.size() == io_detail::kMaxHeaderEntries)
         fail_io(ErrorCode::kInvalidArgument, name,
@@ -156,9 +167,10 @@ PlyHeader parse_header(std::string_view data, const std::string& name) {
       PlyElement& element = header.elements.back();
       if (element.properties.size() == io_detail::kMaxHeaderEntries)
         fail_io(ErrorCode::kInvalidArgument, name,
-                where() + "element '" + element.name + "' has more than " +
+                where() + element_at(element.header_line) + " has more than " +
                     std::to_string(io_detail::kMaxHeaderEntries) + " properties");
       PlyProperty prop;
+      prop.header_line = ln;
       if (tok.size() >= 2 && tok[1] == "list") {
         if (tok.size() != 5) fail_io(ErrorCode::kInvalidArgument, name, where() + "malformed list property");
         if (!parse_type(tok[2], prop.count_type) || !parse_type(tok[3], prop.type))
@@ -172,7 +184,7 @@ PlyHeader parse_header(std::string_view data, const std::string& name) {
       } else {
         if (tok.size() != 3) fail_io(ErrorCode::kInvalidArgument, name, where() + "malformed property line");
         if (!parse_type(tok[1], prop.type))
-          fail_io(ErrorCode::kInvalidArgument, name, where() + "unknown property type " + io_detail::quote(tok[1]));
+          fail_io(ErrorCode::kInvalidArgument, name, where() + "unknown property type");
         prop.name = std::string(tok[2]);
         prop.offset = element.stride;
         element.stride += type_size(prop.type);
@@ -181,7 +193,7 @@ PlyHeader parse_header(std::string_view data, const std::string& name) {
       element.min_tokens += 1;
       element.properties.push_back(std::move(prop));
     } else {
-      fail_io(ErrorCode::kInvalidArgument, name, where() + "unknown header keyword " + io_detail::quote(key));
+      fail_io(ErrorCode::kInvalidArgument, name, where() + "unknown header keyword");
     }
   }
   if (!have_end) fail_io(ErrorCode::kInvalidArgument, name, "malformed header: no end_header line");
@@ -338,7 +350,7 @@ std::size_t skip_binary_list_element(std::string_view data, std::size_t pos, con
     for (const PlyProperty& prop : element.properties) {
       if (!prop.is_list) {
         if (data.size() - pos < type_size(prop.type))
-          fail_truncated(name, "element '" + element.name + "' record " + std::to_string(r) + " of " +
+          fail_truncated(name, element_at(element.header_line) + ", record " + std::to_string(r) + " of " +
                                    std::to_string(element.count) + " ends past the end of the file (byte " +
                                    std::to_string(data.size()) + ")");
         pos += type_size(prop.type);
@@ -346,33 +358,39 @@ std::size_t skip_binary_list_element(std::string_view data, std::size_t pos, con
       }
       const std::size_t cs = type_size(prop.count_type);
       if (data.size() - pos < cs)
-        fail_truncated(name, "element '" + element.name + "' record " + std::to_string(r) + " of " +
+        fail_truncated(name, element_at(element.header_line) + ", record " + std::to_string(r) + " of " +
                                  std::to_string(element.count) + " ends past the end of the file (byte " +
                                  std::to_string(data.size()) + ")");
       std::uint64_t n = load_count(data.data() + pos, prop.count_type, swap, name, pos);
       pos += cs;
       if (!io_detail::mul_fits(n, type_size(prop.type), data.size() - pos))
-        fail_truncated(name, "element '" + element.name + "' record " + std::to_string(r) + ": list '" + prop.name +
-                                 "' of " + std::to_string(n) + " items runs past the end of the file (byte " +
-                                 std::to_string(data.size()) + ")");
+        fail_truncated(name, element_at(element.header_line) + ", record " + std::to_string(r) + ": " +
+                                 property_at(prop.header_line) + ", a list of " + std::to_string(n) +
+                                 " items, runs past the end of the file (byte " + std::to_string(data.size()) + ")");
       pos += n * type_size(prop.type);
     }
   }
   return pos;
 }
 
-PointCloud read_binary(std::string_view data, const PlyHeader& header, std::size_t vertex_index,
-                       const VertexLayout& layout, const std::string& name, const ReadOptions& options) {
-  const bool swap = (header.format == PlyFormat::kBinaryBigEndian) != (std::endian::native == std::endian::big);
+bool swapped(const PlyHeader& header) {
+  return (header.format == PlyFormat::kBinaryBigEndian) != (std::endian::native == std::endian::big);
+}
+
+// Where a binary file's vertex records start (past the elements before them), once the data can hold them.
+std::size_t binary_vertex_offset(std::string_view data, const PlyHeader& header, std::size_t vertex_index,
+                                 const std::string& name) {
+  const bool swap = swapped(header);
   std::size_t pos = header.body_offset;
   // Elements before the vertex element.
   for (std::size_t e = 0; e < vertex_index; ++e) {
     const PlyElement& element = header.elements[e];
     if (element.properties.empty() || element.count == 0) continue;
     if (!io_detail::mul_fits(element.count, element.min_bytes, data.size() - pos))
-      fail_truncated(name, "header says " + std::to_string(element.count) + " '" + element.name +
-                               "' elements of at least " + std::to_string(element.min_bytes) + " bytes, only " +
-                               std::to_string(data.size() - pos) + " bytes follow (byte " + std::to_string(pos) + ")");
+      fail_truncated(name, "header line " + std::to_string(element.header_line) + " declares " +
+                               std::to_string(element.count) + " elements of at least " +
+                               std::to_string(element.min_bytes) + " bytes, only " + std::to_string(data.size() - pos) +
+                               " bytes follow (byte " + std::to_string(pos) + ")");
     if (!element.has_list) {
       pos += element.count * element.stride;
     } else {
@@ -388,8 +406,24 @@ PointCloud read_binary(std::string_view data, const PlyHeader& header, std::size
                              std::to_string(vertex.min_bytes) + " bytes per vertex from byte " + std::to_string(pos) +
                              ", file is " + std::to_string(data.size()) + " bytes)");
   }
-  io_detail::check_point_budget(n, options, name);
+  return pos;
+}
 
+// What the header tells before a point is decoded: the vertex element, its layout, where its binary records start.
+struct PlyPlan {
+  PlyHeader header;
+  std::size_t vertex_index = 0;
+  VertexLayout layout;
+  std::size_t binary_vertex_offset = 0;
+  const PlyElement& vertex() const { return header.elements[vertex_index]; }
+};
+
+PointCloud read_binary(std::string_view data, const PlyPlan& plan, const std::string& name) {
+  const bool swap = swapped(plan.header);
+  const VertexLayout& layout = plan.layout;
+  const PlyElement& vertex = plan.vertex();
+  const std::uint64_t n = vertex.count;
+  std::size_t pos = plan.binary_vertex_offset;
   std::vector<Eigen::Vector3d> points(n);
   std::vector<float> intensity(layout.intensity >= 0 ? n : 0);
   double* xyz_out = points.empty() ? nullptr : points.data()->data();
@@ -438,14 +472,27 @@ PointCloud read_binary(std::string_view data, const PlyHeader& header, std::size
   return io_detail::finish_cloud(std::move(points), std::move(intensity), name);
 }
 
-PointCloud read_ascii(std::string_view data, const PlyHeader& header, std::size_t vertex_index,
-                      const VertexLayout& layout, const std::string& name, const ReadOptions& options) {
+// Refuses a vertex count an ASCII body cannot hold: every value takes at least one character and one separator.
+void check_ascii_vertex_count(std::string_view data, const PlyHeader& header, const PlyElement& vertex,
+                              const std::string& name) {
+  const std::uint64_t n = vertex.count;
+  const std::size_t remaining = data.size() - header.body_offset + 1;
+  if (!io_detail::mul_fits(n, 2 * vertex.min_tokens, remaining))
+    fail_truncated(name, "header says " + std::to_string(n) + " vertices of " + std::to_string(vertex.min_tokens) +
+                             " values, but the " + std::to_string(remaining - 1) +
+                             "-byte body can hold at most " + std::to_string(remaining / (2 * vertex.min_tokens)));
+}
+
+PointCloud read_ascii(std::string_view data, const PlyPlan& plan, const std::string& name) {
+  const PlyHeader& header = plan.header;
+  const std::size_t vertex_index = plan.vertex_index;
+  const VertexLayout& layout = plan.layout;
   io_detail::TokenReader tokens(data.substr(header.body_offset), header.header_lines + 1);
   std::string_view token;
   auto end_of_file = [&](const PlyElement& element, std::uint64_t record) {
-    fail_truncated(name, "header says " + std::to_string(element.count) + " '" + element.name +
-                             "' elements, data ends after " + std::to_string(record) + " (line " +
-                             std::to_string(tokens.line()) + ")");
+    fail_truncated(name, "header line " + std::to_string(element.header_line) + " declares " +
+                             std::to_string(element.count) + " elements, data ends after " + std::to_string(record) +
+                             " (line " + std::to_string(tokens.line()) + ")");
   };
   for (std::size_t e = 0; e < vertex_index; ++e) {
     const PlyElement& element = header.elements[e];
@@ -457,23 +504,15 @@ PointCloud read_ascii(std::string_view data, const PlyHeader& header, std::size_
         std::uint64_t count;
         if (!io_detail::parse_uint64(token, count))
           fail_io(ErrorCode::kInvalidArgument, name,
-                  "line " + std::to_string(tokens.line()) + ": list count " + io_detail::quote(token) +
-                      " of element '" + element.name + "' is not a non-negative integer");
+                  "line " + std::to_string(tokens.line()) + ": a list count of " + element_at(element.header_line) +
+                      " is not a non-negative integer");
         for (std::uint64_t k = 0; k < count; ++k)
           if (!tokens.next(token)) end_of_file(element, r);
       }
     }
   }
-  const PlyElement& vertex = header.elements[vertex_index];
+  const PlyElement& vertex = plan.vertex();
   const std::uint64_t n = vertex.count;
-  // Every ASCII value takes at least one character and one separator: refuse impossible counts up front.
-  const std::size_t remaining = data.size() - header.body_offset + 1;
-  if (!io_detail::mul_fits(n, 2 * vertex.min_tokens, remaining))
-    fail_truncated(name, "header says " + std::to_string(n) + " vertices of " + std::to_string(vertex.min_tokens) +
-                             " values, but the " + std::to_string(remaining - 1) +
-                             "-byte body can hold at most " + std::to_string(remaining / (2 * vertex.min_tokens)));
-  io_detail::check_point_budget(n, options, name);
-
   std::vector<Eigen::Vector3d> points(n);
   std::vector<float> intensity(layout.intensity >= 0 ? n : 0);
   for (std::uint64_t i = 0; i < n; ++i) {
@@ -486,8 +525,8 @@ PointCloud read_ascii(std::string_view data, const PlyHeader& header, std::size_
         std::uint64_t count;
         if (!io_detail::parse_uint64(token, count))
           fail_io(ErrorCode::kInvalidArgument, name,
-                  "line " + std::to_string(tokens.line()) + ": vertex " + std::to_string(i) + ": list count " +
-                      io_detail::quote(token) + " is not a non-negative integer");
+                  "line " + std::to_string(tokens.line()) + ": vertex " + std::to_string(i) + ": the list count of " +
+                      property_at(prop.header_line) + " is not a non-negative integer");
         for (std::uint64_t k = 0; k < count; ++k)
           if (!tokens.next(token))
             fail_truncated(name, "header says " + std::to_string(n) + " vertices, data holds " + std::to_string(i));
@@ -496,8 +535,8 @@ PointCloud read_ascii(std::string_view data, const PlyHeader& header, std::size_
       double v;
       if (!io_detail::parse_double(token, v))
         fail_io(ErrorCode::kInvalidArgument, name,
-                "line " + std::to_string(tokens.line()) + ": vertex " + std::to_string(i) + ": property '" +
-                    prop.name + "' value " + io_detail::quote(token) + " is not a number");
+                "line " + std::to_string(tokens.line()) + ": vertex " + std::to_string(i) + ": the value of " +
+                    property_at(prop.header_line) + " is not a number");
       for (int a = 0; a < 3; ++a)
         if (layout.xyz[a] == static_cast<int>(p)) points[i][a] = v;
       if (layout.intensity == static_cast<int>(p)) intensity[i] = static_cast<float>(v);
@@ -506,23 +545,41 @@ PointCloud read_ascii(std::string_view data, const PlyHeader& header, std::size_
   return io_detail::finish_cloud(std::move(points), std::move(intensity), name);
 }
 
-}  // namespace
-
-PointCloud read_ply_bytes(std::string_view data, const std::string& name, const ReadOptions& options) {
-  const PlyHeader header = parse_header(data, name);
-  std::size_t vertex_index = header.elements.size();
+// The header pass (declared_points stops here): the plan, its vertex count checked against the data and
+// options.max_points; no point decoded.
+PlyPlan plan_ply(std::string_view data, const std::string& name, const ReadOptions& options) {
+  PlyPlan plan;
+  plan.header = parse_header(data, name);
+  const PlyHeader& header = plan.header;
+  plan.vertex_index = header.elements.size();
   for (std::size_t e = 0; e < header.elements.size(); ++e) {
     if (header.elements[e].name == "vertex") {
-      vertex_index = e;
+      plan.vertex_index = e;
       break;
     }
   }
-  if (vertex_index == header.elements.size())
+  if (plan.vertex_index == header.elements.size())
     fail_io(ErrorCode::kInvalidArgument, name, "malformed header: no 'vertex' element");
-  const VertexLayout layout = find_vertex_layout(header.elements[vertex_index], name);
-  if (header.elements[vertex_index].count == 0) fail_io(ErrorCode::kInvalidArgument, name, "no points (element vertex 0)");
-  if (header.format == PlyFormat::kAscii) return read_ascii(data, header, vertex_index, layout, name, options);
-  return read_binary(data, header, vertex_index, layout, name, options);
+  plan.layout = find_vertex_layout(plan.vertex(), name);
+  if (plan.vertex().count == 0) fail_io(ErrorCode::kInvalidArgument, name, "no points (element vertex 0)");
+  if (header.format == PlyFormat::kAscii)
+    check_ascii_vertex_count(data, header, plan.vertex(), name);
+  else
+    plan.binary_vertex_offset = binary_vertex_offset(data, header, plan.vertex_index, name);
+  io_detail::check_point_budget(plan.vertex().count, options, name);
+  return plan;
+}
+
+}  // namespace
+
+PointCloud read_ply_bytes(std::string_view data, const std::string& name, const ReadOptions& options) {
+  const PlyPlan plan = plan_ply(data, name, options);
+  return plan.header.format == PlyFormat::kAscii ? read_ascii(data, plan, name) : read_binary(data, plan, name);
+}
+
+std::uint64_t io_detail::declared_ply_points(std::string_view data, const std::string& name,
+                                             const ReadOptions& options) {
+  return plan_ply(data, name, options).vertex().count;
 }
 
 PointCloud read_ply(const std::string& path, const ReadOptions& options) {

@@ -167,8 +167,7 @@ PointCloud read_ptx_bytes(std::string_view data, const std::string& name, const 
         double value;
         if (!io_detail::parse_double(tokens[t], value))
           fail_io(ErrorCode::kInvalidArgument, name,
-                  "line " + std::to_string(ln) + ": column " + std::to_string(t + 1) + " value " +
-                      io_detail::quote(tokens[t]) + " is not a number");
+                  "line " + std::to_string(ln) + ": column " + std::to_string(t + 1) + " is not a number");
         if (t < 4) v[t] = value;
       }
       const bool no_return = tokens.size() >= 3 && v[0] == 0.0 && v[1] == 0.0 && v[2] == 0.0;

@@ -65,8 +65,7 @@ PointCloud read_xyz_bytes(std::string_view data, const std::string& name, const 
         continue;
       }
       fail_io(ErrorCode::kInvalidArgument, name,
-              "line " + std::to_string(ln) + ": column " + std::to_string(bad + 1) + " value " +
-                  io_detail::quote(tokens[bad]) + " is not a number");
+              "line " + std::to_string(ln) + ": column " + std::to_string(bad + 1) + " is not a number");
     }
     seen_content = true;
     if (tokens.size() < 3)

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "k4reg/util/held_bytes.h"
+
 namespace k4reg {
 namespace {
 
@@ -139,6 +141,8 @@ FreeSpaceImage::Located FreeSpaceImage::locate(const Eigen::Vector3f& q) const {
   const int e = std::min(rows_ - 1, static_cast<int>(elevation * (rows_ / M_PI)));
   return {static_cast<int>(index(e, a)), range};
 }
+
+std::size_t FreeSpaceImage::bytes() const { return held_bytes(nearest_) + held_bytes(open_); }
 
 FreeSpaceImage::Seen FreeSpaceImage::classify(const Eigen::Vector3f& q) const {
   const Located at = locate(q);

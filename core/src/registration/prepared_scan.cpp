@@ -1,9 +1,11 @@
 #include "k4reg/registration/prepared_scan.h"
 
+#include "k4reg/geometry/neighbor_grid.h"
 #include "k4reg/registration/pose_score.h"
 #include "k4reg/registration/scanner_sampling.h"
 #include "k4reg/registration/single_view.h"
 #include "k4reg/util/error.h"
+#include "k4reg/util/held_bytes.h"
 
 #include <atomic>
 #include <map>
@@ -12,6 +14,39 @@
 
 namespace k4reg {
 namespace {
+
+// The heap bytes an entry's value holds beyond sizeof itself. Read while other entries are being made: a value
+// is never changed once made (a pyramid's target search updates Pyramid::bytes instead).
+std::size_t bytes_of(const IcpPyramid& pyramid) {
+  std::size_t total = held_bytes(pyramid.stages);
+  for (const IcpPyramid::Stage& stage : pyramid.stages)
+    total += held_bytes(stage.points) + held_bytes(stage.normals) +
+             (stage.grid ? sizeof(NeighborGrid) + stage.grid->bytes() : 0);
+  return total;
+}
+
+struct Pyramid {
+  explicit Pyramid(IcpPyramid made) : pyramid(std::move(made)), bytes(bytes_of(pyramid)) {}
+  IcpPyramid pyramid;
+  std::once_flag target_search;  // the grids and normals, added when the scan first serves as a target
+  // bytes_of(pyramid), kept apart: the target search may be adding to the pyramid while bytes() is asked.
+  std::atomic<std::size_t> bytes;
+};
+
+std::size_t bytes_of(const Pyramid& entry) { return entry.bytes.load(std::memory_order_relaxed); }
+std::size_t bytes_of(const VoxelizedCloud& voxels) {
+  return held_bytes(voxels.cloud.points) + held_bytes(voxels.cloud.intensity) + held_bytes(voxels.counts);
+}
+std::size_t bytes_of(const ScanKeypoints& keypoints) {
+  return keypoints.signal.capacity() + held_bytes(keypoints.points) + held_bytes(keypoints.labels);
+}
+std::size_t bytes_of(const ScannerPosition& position) { return position.reason.capacity(); }
+std::size_t bytes_of(const NeighbourAngles& angles) { return angles.bytes(); }
+std::size_t bytes_of(const FreeSpaceImage& image) { return image.bytes(); }
+// Nothing on the heap.
+std::size_t bytes_of(const Sampling&) { return 0; }
+std::size_t bytes_of(const std::optional<Eigen::Vector3f>&) { return 0; }
+std::size_t bytes_of(double) { return 0; }
 
 // Values by key, each made once from what `make` returns (std::call_once: a maker that throws leaves the entry
 // to the next caller).
@@ -42,20 +77,26 @@ class Entries {
     return *entry->value;
   }
 
+  // What the entries hold: each entry, its value and what that holds on the heap (values being made: the entry).
+  std::size_t bytes() {
+    const std::lock_guard lock(mutex_);
+    std::size_t total = 0;
+    for (const auto& [key, entry] : entries_) {
+      total += sizeof(Key) + sizeof(Entry) + kNodeBytes;
+      if (entry->ready.load(std::memory_order_acquire)) total += sizeof(Value) + bytes_of(*entry->value);
+    }
+    return total;
+  }
+
  private:
   struct Entry {
     std::once_flag once;
     std::unique_ptr<Value> value;
     std::atomic<bool> ready{false};  // value made (made() reads it without the once_flag)
   };
+  static constexpr std::size_t kNodeBytes = 32;  // a std::map node's links and colour
   std::mutex mutex_;
   std::map<Key, std::unique_ptr<Entry>> entries_;
-};
-
-struct Pyramid {
-  explicit Pyramid(IcpPyramid made) : pyramid(std::move(made)) {}
-  IcpPyramid pyramid;
-  std::once_flag target_search;  // the grids and normals, added when the scan first serves as a target
 };
 
 }  // namespace
@@ -75,6 +116,13 @@ struct PreparedScan::Cache {
 
 PreparedScan::PreparedScan(const PointCloud& cloud) : cloud_(&cloud), cache_(std::make_unique<Cache>()) {}
 PreparedScan::PreparedScan(PreparedScan&&) noexcept = default;
+
+std::size_t PreparedScan::bytes() const {
+  Cache& c = *cache_;
+  return sizeof(Cache) + c.sampling.bytes() + c.voxels.bytes() + c.pyramids.bytes() + c.keypoints.bytes() +
+         c.neighbour_angles.bytes() + c.scanner.bytes() + c.declared_scanner.bytes() + c.free_space.bytes() +
+         c.view_direction.bytes() + c.view_free_space.bytes() + c.self_agreement.bytes();
+}
 PreparedScan::~PreparedScan() = default;
 
 const Sampling& PreparedScan::sampling() const {
@@ -92,7 +140,11 @@ const IcpPyramid& PreparedScan::pyramid(double sigma_m, const IcpParams& params,
   Pyramid& entry = cache_->pyramids.get({sigma_m, params.stages, params.max_distance_factor}, [&] {
     return make_icp_pyramid(voxels(sigma_m, cancel).cloud.points, at_sigma, false, cancel);
   });
-  if (as_target) std::call_once(entry.target_search, [&] { add_target_search(entry.pyramid, at_sigma, cancel); });
+  if (as_target)
+    std::call_once(entry.target_search, [&] {
+      add_target_search(entry.pyramid, at_sigma, cancel);
+      entry.bytes.store(bytes_of(entry.pyramid), std::memory_order_relaxed);
+    });
   return entry.pyramid;
 }
 

@@ -17,6 +17,7 @@
 
 #include "k4reg/geometry/hash_map.h"
 #include "k4reg/geometry/voxel_grid.h"
+#include "k4reg/util/held_bytes.h"
 #include "k4reg/util/median.h"
 
 namespace k4reg {
@@ -129,6 +130,8 @@ NeighbourAngles NeighbourAngles::thinned(std::size_t pairs) const {
   }
   return out;
 }
+
+std::size_t NeighbourAngles::bytes() const { return held_bytes(points_) + held_bytes(neighbours_); }
 
 std::vector<Eigen::Vector3f> NeighbourAngles::near_scanner_candidates() const {
   std::vector<std::pair<float, std::size_t>> by_distance;

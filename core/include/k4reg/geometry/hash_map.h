@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "k4reg/util/held_bytes.h"
+
 namespace k4reg {
 
 class VoxelKeyMap {
@@ -39,6 +41,7 @@ class VoxelKeyMap {
   }
 
   std::size_t size() const { return size_; }
+  std::size_t bytes() const { return held_bytes(keys_) + held_bytes(values_); }  // heap bytes held
 
  private:
   std::size_t slot(std::uint64_t key) const {

@@ -24,6 +24,7 @@ class NeighborGrid {
   NeighborGrid(const std::vector<Eigen::Vector3f>& points, double cell_m, Queries queries = Queries::kMany);
 
   double cell_m() const { return cell_m_; }
+  std::size_t bytes() const;  // heap bytes held
 
   // Calls f(index, squared_distance) for every point within radius_m of q, in the order of the cells' packed
   // keys (z, y, x) and, within a cell, of insertion. For radius_m <= cell_m it visits only the occupied

@@ -58,6 +58,7 @@ class FreeSpaceImage {
   };
   Seen classify(const Eigen::Vector3f& q) const;
   const Viewpoint& viewpoint() const { return viewpoint_; }
+  std::size_t bytes() const;  // heap bytes held
 
  private:
   struct Located {

@@ -6,7 +6,8 @@
 // Thread-safe: pairs running at once share the entries (the first to ask computes, the others wait; a cancelled
 // computation leaves the entry to the next asker).
 // Memory, per scale used: the voxel grid (16 B per voxel, 20 with intensity), the pyramid (its points, and for a
-// target its neighbour grids and normals: about 60 B per voxel in all), the keypoints and the free-space image.
+// target its neighbour grids and normals: about 60 B per voxel in all), the keypoints and the free-space image;
+// bytes() counts what the entries made so far hold.
 #pragma once
 
 #include <cstdint>
@@ -42,6 +43,9 @@ class PreparedScan {
   ~PreparedScan();
 
   const PointCloud& cloud() const { return *cloud_; }
+  // The heap bytes of the entries made so far (capacities; not the cloud, which is the caller's). Cheap: a walk
+  // over the entries and their vectors, no point visited. Thread-safe, while other pairs add entries.
+  std::size_t bytes() const;
   const Sampling& sampling() const;
   const VoxelizedCloud& voxels(double sigma_m, const CancellationToken* cancel) const;
   // At sigma_m's voxels, with params' stages; as_target adds the neighbour grids and normals.

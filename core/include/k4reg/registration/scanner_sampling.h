@@ -44,6 +44,7 @@ class NeighbourAngles {
   const std::vector<Eigen::Vector3f>& points() const { return points_; }
   // Every k-th of the points with their neighbours, about `pairs` of them.
   NeighbourAngles thinned(std::size_t pairs) const;
+  std::size_t bytes() const;  // heap bytes held
 
   static constexpr std::size_t kNeighbours = 6;
 
