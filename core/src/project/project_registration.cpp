@@ -470,7 +470,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
       scan.reason = fmt::format(
           "held too weakly: its links' margins (strength {:.3f} < {}) cannot tell it from a twin placement",
           holds[i].strength, kAmbiguousMargin);
-      if (!holds[i].motion || holds[i].strength <= 0.0) continue;
+      if (!holds[i].motion) continue;
       scan.ambiguous = true;
       scan.candidate_poses = {scan.pose, *holds[i].motion * scan.pose};
       scan.reason += "; both placements are given, the one its links prefer first";

@@ -88,7 +88,7 @@ std::vector<TwinHold> holds_against_twins(const ProjectResult& project, const st
                       project.reference, cap);
   };
   for (std::size_t i = 0; i < n; ++i) {
-    if (bound[i].strength >= kAmbiguousMargin || bound[i].strength <= 0.0) continue;
+    if (bound[i].strength >= kAmbiguousMargin) continue;
     // The twins its side of the per-link cut could take as one: the motions that every link across the cut (that
     // holds anything) offers a candidate for, read off the first such link's candidates with its moving end moved.
     const std::vector<std::size_t>& side = bound[i].moves_with;

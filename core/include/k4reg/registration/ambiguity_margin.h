@@ -18,11 +18,15 @@ constexpr double ambiguous_below(bool free_space_used) {
   return free_space_used ? kAmbiguousMargin : kGeometryOnlyAmbiguousMargin;
 }
 
-// A margin as it weighs against kAmbiguousMargin: one judged on geometry alone is scaled down by
-// kAmbiguousMargin / kGeometryOnlyAmbiguousMargin, so that a project's rules (loops that vouch, two-sided margins,
-// how firmly links hold a scan: all against kAmbiguousMargin) hold a geometry-only link to its pair's bar.
+// A margin as it weighs against kAmbiguousMargin in a project's rules (loops that vouch, two-sided margins, how
+// firmly links hold a scan), which add the margins of independent links. Free-space margins are independent
+// evidence. On geometry alone a margin under kGeometryOnlyAmbiguousMargin is none: a symmetric scene's twin wins
+// such margins systematically (the same half turn in every pair of the hall, so three links at 0.1 each, or a loop
+// of two, would add up to a confident wrong placement); above it, it counts scaled by the ratio of the two bars.
 constexpr double margin_against_free_space_bar(double margin, bool free_space_used) {
-  return margin * kAmbiguousMargin / ambiguous_below(free_space_used);
+  if (free_space_used) return margin;
+  const bool under_the_bar = margin < kGeometryOnlyAmbiguousMargin && margin > -kGeometryOnlyAmbiguousMargin;
+  return under_the_bar ? 0.0 : margin * kAmbiguousMargin / kGeometryOnlyAmbiguousMargin;
 }
 
 // Score a's margin over score b, (a - b) / max(a, b) (0 where neither scores), against the free-space bar.
