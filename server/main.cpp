@@ -33,11 +33,6 @@ using Clock = std::chrono::steady_clock;
 
 int milliseconds(double seconds) { return static_cast<int>(std::min(seconds * 1000.0, 2.0e9)); }
 
-// gRPC's receive quota (set_connection_options): half the memory budget, at least 64 MiB.
-std::size_t receive_quota_bytes(const ServerConfig& config) {
-  return std::max<std::size_t>((config.memory_budget_mb << 20) / 2, std::size_t(64) << 20);
-}
-
 void set_connection_options(grpc::ServerBuilder& builder, const ServerConfig& config) {
   // The largest message is a peer's pair job (--max-pair-mb); Register and RegisterProject check --max-inline-mb.
   // What grpc++ 1.51 offers per method, measured: nothing. It has one receive limit per server (this one); a
@@ -49,14 +44,13 @@ void set_connection_options(grpc::ServerBuilder& builder, const ServerConfig& co
   builder.SetMaxReceiveMessageSize(static_cast<int>(limit_mb * (1 << 20)) + (64 << 10));
   // What bounds the bytes of all calls together is the resource quota: gRPC's reads draw on it, and under its
   // pressure the transport resets streams (RESOURCE_EXHAUSTED, "RST_STREAM with error code 11") until it is
-  // back under. Half the memory budget, at least 64 MiB: a message over it would carry a job over the budget
-  // anyway (a pair's 16 bytes per point, a binary PLY's 12, become 60 in a job). Measured (tests/integration/
+  // back under (--grpc-receive-quota-mb; by default half the memory budget). Measured (tests/integration/
   // grpc_hostile_clients_test.cpp): 4 unauthenticated 150 MB messages at once took the resident set to 1.2 GB
   // without it; 4 x 100 MB with a budget of 256 MiB peak at 340-390 MiB with it (the quota is soft: reclamation
   // runs after the read, and an admitted message is copied once more while it is parsed). A smaller receive
   // limit alone does not bound it: with 1 MiB and no quota, the 4 x 100 MB still peaked at 405 MiB.
   grpc::ResourceQuota quota("k4reg-receive");  // the builder keeps a reference
-  builder.SetResourceQuota(quota.Resize(receive_quota_bytes(config)));
+  builder.SetResourceQuota(quota.Resize(config.grpc_receive_quota_mb << 20));
   builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, milliseconds(config.keepalive_time_s));
   builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, 20'000);
   // Clients waiting minutes for a job may ping to keep NATs and proxies open; allow it every 10 s.
@@ -137,7 +131,7 @@ int serve(const ServerConfig& config, const sigset_t& stop_signals) {
   nlohmann::json serving{{"grpc_port", port},
                          {"server_id", config.server_id},
                          {"tls", tls.has_value()},
-                         {"grpc_receive_quota_mb", receive_quota_bytes(config) >> 20}};
+                         {"grpc_receive_quota_mb", config.grpc_receive_quota_mb}};
   if (probes) {
     probes->start();
     serving["health_port"] = probes->port();

@@ -1,5 +1,6 @@
 #include "server_config.h"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -77,6 +78,10 @@ void add_config_options(CLI::App& app, ServerConfig& c) {
   app.add_option("--memory-budget-mb", c.memory_budget_mb,
                  "estimated memory of all running jobs (60 bytes per input point), 0 = half the RAM")
       ->envname("K4REG_MEMORY_BUDGET_MB");
+  app.add_option("--grpc-receive-quota-mb", c.grpc_receive_quota_mb,
+                 "bytes all gRPC calls may be receiving at once, before any token is checked (beyond: "
+                 "RESOURCE_EXHAUSTED), MiB; at least the largest message; 0 = half of --memory-budget-mb (64 at least)")
+      ->envname("K4REG_GRPC_RECEIVE_QUOTA_MB");
   app.add_option("--spool-dir", c.spool_dir, "parent folder of the upload spool (default: system temp)")
       ->envname("K4REG_SPOOL_DIR");
   app.add_option("--drain-grace-s", c.drain_grace_s, "on SIGTERM, seconds running jobs may take before cancellation")
@@ -159,6 +164,16 @@ void finish_config(ServerConfig& c) {
     gethostname(host, sizeof host - 1);
     c.server_id = std::string(host) + ":" + std::to_string(getpid());
   }
+  if (c.grpc_receive_quota_mb == 0) {
+    // A message over half the budget would carry a job over the budget anyway (a pair's 16 bytes per point, a
+    // binary PLY's 12, become 60 in a job).
+    c.grpc_receive_quota_mb = std::max<std::size_t>(c.memory_budget_mb / 2, 64);
+  } else if (static_cast<double>(c.grpc_receive_quota_mb) < std::max(static_cast<double>(c.max_inline_mb), c.max_pair_mb) + 1) {
+    throw CLI::ValidationError("--grpc-receive-quota-mb",
+                               fmt::format("must hold the largest message (--max-inline-mb {}, --max-pair-mb {:g}) and "
+                                           "1 MiB more",
+                                           c.max_inline_mb, c.max_pair_mb));
+  }
   if (c.queue_size == 0) throw CLI::ValidationError("--queue-size", "must be at least 1");
   if (c.pair_workers == 0) c.pair_workers = c.workers;
   if (c.pair_queue_size == 0) throw CLI::ValidationError("--pair-queue-size", "must be at least 1");
@@ -186,6 +201,7 @@ nlohmann::json config_to_json(const ServerConfig& c) {
           {"max_project_scans", c.max_project_scans},
           {"max_project_points", c.max_project_points},
           {"memory_budget_mb", c.memory_budget_mb},
+          {"grpc_receive_quota_mb", c.grpc_receive_quota_mb},
           {"spool_dir", c.spool_dir},
           {"drain_grace_s", c.drain_grace_s},
           {"auth", !c.auth_token.empty()},

@@ -30,6 +30,7 @@ struct ServerConfig {
   std::size_t max_project_scans = 500;         // scans (and so uploads) per project request
   std::uint64_t max_project_points = 500'000'000;  // points per project, as the scans' headers declare them
   std::size_t memory_budget_mb = 0;           // for all running jobs; 0 = half the physical memory
+  std::size_t grpc_receive_quota_mb = 0;      // bytes all gRPC calls may be receiving at once; 0 = half the budget
   std::string spool_dir;                      // parent of the per-process upload directory; "" = system temp
   double drain_grace_s = 25.0;                // after SIGTERM, running jobs get this long before cancellation
   std::string auth_token;                     // if set, calls need "authorization: Bearer <token>"

@@ -477,10 +477,13 @@ def check_kubernetes(d, problems):
         pair_workers = int(values.get("K4REG_PAIR_WORKERS") or 0) or workers
         pairs = math.ceil(float(values["K4REG_MAX_PAIR_MB"]) * (pair_workers + int(values["K4REG_PAIR_QUEUE_SIZE"])))
         pairs += int(values["K4REG_PAIR_CACHE_MB"])  # their scans, kept with their preparation
-        needed = budget + inline + pairs + PROCESS_OVERHEAD_MIB
+        # Messages still arriving, before any token is checked (server_config.cpp: half the budget by default).
+        receiving = int(values.get("K4REG_GRPC_RECEIVE_QUOTA_MB") or 0) or max(budget // 2, 64)
+        needed = budget + inline + pairs + receiving + PROCESS_OVERHEAD_MIB
         problems.expect(0 < budget and needed <= quantity(limits["memory"]), where,
                         f"memory limit {limits['memory']} < budget {budget} + inline requests {inline} + pair jobs "
-                        f"and their kept scans {pairs} + process {PROCESS_OVERHEAD_MIB} MiB")
+                        f"and their kept scans {pairs} + gRPC messages arriving {receiving} + process "
+                        f"{PROCESS_OVERHEAD_MIB} MiB")
 
     check_pod_isolation(problems, where, pod, container, values)
 

@@ -15,6 +15,8 @@ TEST(Config, EnvironmentVariablesConfigureTheServerAndTheTokenIsNeverLogged) {
                             {"K4REG_QUEUE_SIZE", "5"},
                             {"K4REG_MAX_POINTS", "123456"},
                             {"K4REG_MEMORY_BUDGET_MB", "777"},
+                            {"K4REG_GRPC_RECEIVE_QUOTA_MB", "300"},
+                            {"K4REG_MAX_PAIR_MB", "128"},  // the quota holds the largest message
                             {"K4REG_DRAIN_GRACE_S", "4.5"},
                             {"K4REG_AUTH_TOKEN", "hunter2-token"},
                             {"K4REG_MAX_UPLOAD_MB", "99"},
@@ -29,6 +31,7 @@ TEST(Config, EnvironmentVariablesConfigureTheServerAndTheTokenIsNeverLogged) {
   EXPECT_EQ(config["queue_size"], 5);
   EXPECT_EQ(config["max_points"], 123456);
   EXPECT_EQ(config["memory_budget_mb"], 777);
+  EXPECT_EQ(config["grpc_receive_quota_mb"], 300);
   EXPECT_EQ(config["drain_grace_s"], 4.5);
   EXPECT_EQ(config["auth"], true);
   EXPECT_EQ(config["max_upload_mb"], 99);
@@ -37,6 +40,7 @@ TEST(Config, EnvironmentVariablesConfigureTheServerAndTheTokenIsNeverLogged) {
   EXPECT_EQ(server.log().find("hunter2-token"), std::string::npos);
   // Port 0 was bound to a real port, which the log names as well.
   EXPECT_EQ(server.log_lines("serving").at(0)["grpc_port"], server.port());
+  EXPECT_EQ(server.log_lines("serving").at(0)["grpc_receive_quota_mb"], 300);
 }
 
 TEST(Config, TlsWithCertificateAndKey) {
