@@ -197,7 +197,8 @@ Eigen::Vector3f PreparedScan::scanner_local(const CancellationToken* cancel) con
 }
 
 bool PreparedScan::scanner_surrounded(const CancellationToken* cancel) const {
-  return scanner(cancel).source != ScannerSource::kNone && surrounded_by(cloud_->points, scanner_local(cancel));
+  return could_surround_a_scanner(cloud_->points) && scanner(cancel).source != ScannerSource::kNone &&
+         surrounded_by(cloud_->points, scanner_local(cancel));
 }
 
 const FreeSpaceImage& PreparedScan::free_space(double margin_m) const {

@@ -350,6 +350,10 @@ ScannerEstimate estimate_scanner_position(const NeighbourAngles& angles, const C
   return out;
 }
 
+namespace {
+constexpr double kMinScannerRange = 1.0;  // a terrestrial scanner's median range, at least
+}  // namespace
+
 bool surrounded_by(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& at) {
   if (points.empty()) return false;
   Eigen::Vector3f low = points.front(), high = points.front();
@@ -358,8 +362,14 @@ bool surrounded_by(const std::vector<Eigen::Vector3f>& points, const Eigen::Vect
   std::vector<double> ranges;
   ranges.reserve(points.size());
   for (const Eigen::Vector3f& p : points) ranges.push_back((p - at).norm());
-  constexpr double kMinScannerRange = 1.0;
   return median(std::move(ranges)) >= kMinScannerRange;
+}
+
+bool could_surround_a_scanner(const std::vector<Eigen::Vector3f>& points) {
+  if (points.empty()) return false;
+  Eigen::Vector3f low = points.front(), high = points.front();
+  for (const Eigen::Vector3f& p : points) low = low.cwiseMin(p), high = high.cwiseMax(p);
+  return (high - low).norm() >= kMinScannerRange;
 }
 
 namespace {
