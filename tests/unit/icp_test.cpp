@@ -1,6 +1,7 @@
 // Point-to-plane ICP and the normals it uses, on synthetic geometry with a known answer: normals of a
 // plane are its normal, ICP brings a moved room corner (three planes fix all six degrees of freedom)
-// back onto itself, and without iterations it only measures the pose it is given.
+// back onto itself, alike far from the frame's origin, and without iterations it only measures the pose it
+// is given.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -69,6 +70,32 @@ TEST(Icp, BringsAMovedCornerBack) {
   EXPECT_LT(translation_error_m, 0.002);
   EXPECT_GT(r.overlap, 0.9);
   EXPECT_LT(r.rmse_m, 0.005);
+}
+
+// The same corner and motion 40 m from the frame's origin (a file in shifted coordinates): ICP turns the source
+// about its own centre, so it converges as at the origin, to the same pose. About the origin, each rotation
+// step was a translation of metres and float rounding of the moved points a step noise above the bar.
+TEST(Icp, ConvergesAlikeFarFromTheFramesOrigin) {
+  std::mt19937 rng(2);
+  const auto target_points = corner(true, rng);
+  const Eigen::Matrix4d truth = small_motion();
+  const auto source_points = moved(corner(true, rng), truth.inverse());
+  Eigen::Matrix4d far = Eigen::Matrix4d::Identity();
+  far.topRightCorner<3, 1>() = Eigen::Vector3d(30.0, -25.0, 8.0);
+  IcpParams params;
+  params.voxel_m = 0.02;
+  auto run = [&](const Eigen::Matrix4d& placement) {
+    return refine_icp(make_icp_pyramid(moved(source_points, placement), params, false),
+                      make_icp_pyramid(moved(target_points, placement), params, true), Eigen::Matrix4d::Identity(), params);
+  };
+  const IcpResult at_origin = run(Eigen::Matrix4d::Identity()), away = run(far);
+  ASSERT_TRUE(at_origin.converged);
+  EXPECT_TRUE(away.converged);
+  EXPECT_LE(away.iterations, at_origin.iterations + 2);
+  const Eigen::Matrix4d error = (far * truth * far.inverse()).inverse() * away.transform;
+  EXPECT_LT(rotation_angle_deg(error.topLeftCorner<3, 3>()), 0.05);
+  EXPECT_LT((error.topLeftCorner<3, 3>() * Eigen::Vector3d(31.5, -23.5, 9.5) + error.col(3).head<3>() -
+             Eigen::Vector3d(31.5, -23.5, 9.5)).norm(), 0.002);  // at the corner's centre
 }
 
 TEST(Icp, WithoutIterationsItOnlyMeasuresThePose) {

@@ -1,6 +1,7 @@
 #include "k4reg/geometry/rigid_motion.h"
 
 #include <Eigen/Geometry>
+#include <cmath>
 
 namespace k4reg {
 
@@ -19,6 +20,24 @@ double displacement_m(const Eigen::Matrix4d& t, double lever_arm_m) {
   const double angle = Eigen::AngleAxisd(Eigen::Matrix3d(t.topLeftCorner<3, 3>())).angle();
   const double shift = t.topRightCorner<3, 1>().norm();
   return std::sqrt(shift * shift + lever_arm_m * angle * lever_arm_m * angle);
+}
+
+double shift_at_m(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b, const Eigen::Vector3d& at_m) {
+  const Eigen::Matrix4d d = a - b;
+  return (d.topLeftCorner<3, 3>() * at_m + d.topRightCorner<3, 1>()).norm();
+}
+
+bool distinct_transforms(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b, const Eigen::Vector3d& at_m,
+                         double min_angle_deg, double min_shift_m) {
+  const Eigen::Matrix3d turn = a.topLeftCorner<3, 3>().transpose() * b.topLeftCorner<3, 3>();
+  const double angle_deg = Eigen::AngleAxisd(turn).angle() * 180.0 / M_PI;
+  return angle_deg >= min_angle_deg || shift_at_m(a, b, at_m) >= min_shift_m;
+}
+
+Eigen::Vector3d centroid(const std::vector<Eigen::Vector3f>& points) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3f& p : points) sum += p.cast<double>();
+  return points.empty() ? sum : Eigen::Vector3d(sum / static_cast<double>(points.size()));
 }
 
 Eigen::Matrix4d rigid_inverse(const Eigen::Matrix4d& t) {

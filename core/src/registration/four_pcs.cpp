@@ -9,9 +9,9 @@
 
 #include "k4reg/registration/congruent_sets.h"
 #include "k4reg/util/error.h"
-#include "k4reg/registration/metrics.h"
 #include "k4reg/geometry/neighbor_grid.h"
 #include "k4reg/geometry/rigid_fit.h"
+#include "k4reg/geometry/rigid_motion.h"
 #include "k4reg/geometry/sampling.h"
 
 namespace k4reg {
@@ -86,9 +86,9 @@ struct BaseOutcome {
   // Score a newcomer must beat to matter.
   double floor() const { return candidates.size() < kKept ? 0.0 : candidates.back().score; }
 
-  void offer(const Candidate& c, double min_angle_deg, double min_translation_m) {
+  void offer(const Candidate& c, const Eigen::Vector3d& centre, double min_angle_deg, double min_translation_m) {
     auto same = std::find_if(candidates.begin(), candidates.end(), [&](const Candidate& k) {
-      return !distinct_transforms(k.transform, c.transform, min_angle_deg, min_translation_m);
+      return !distinct_transforms(k.transform, c.transform, centre, min_angle_deg, min_translation_m);
     });
     if (same != candidates.end()) {
       if (c.score <= same->score) return;
@@ -112,13 +112,6 @@ int bases_for_overlap(double overlap) {
   return std::max(4, static_cast<int>(std::ceil(first_estimate / (0.3 * 2.0 * o))));
 }
 
-bool distinct_transforms(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b, double min_angle_deg,
-                         double min_translation_m) {
-  const double angle = rotation_angle_deg(a.topLeftCorner<3, 3>().transpose() * b.topLeftCorner<3, 3>());
-  const double shift = (a.topRightCorner<3, 1>() - b.topRightCorner<3, 1>()).norm();
-  return angle >= min_angle_deg || shift >= min_translation_m;
-}
-
 FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::vector<Eigen::Vector3f>& target,
                          const FourPcsParams& params, const CancellationToken* cancel, const ProgressCallback& progress) {
   if (source.size() < 4 || target.size() < 4)
@@ -131,6 +124,7 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
   const double min_width = std::max(0.1 * max_width, 4.0 * params.delta_m);
   const PairIndex pairs(target, min_width - tolerance.pair_m, max_width + tolerance.pair_m, cancel);
   const Verifier verifier(source, target, kInlierFactor * params.delta_m, params.verification_points, params.seed);
+  const Eigen::Vector3d centre = centroid(source);  // where poses are compared
   const int bases = params.max_bases > 0 ? params.max_bases : bases_for_overlap(params.overlap);
   const bool labelled = params.source_labels && params.target_labels;
   if (labelled && (params.source_labels->size() != source.size() || params.target_labels->size() != target.size()))
@@ -177,7 +171,7 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
           if (!passes_prescreens(verifier, t, 0.5 * beat)) continue;
           const double full = verifier.score(t, verifier.size(), std::max(out.floor(), 0.5 * global_best));
           if (full > out.floor() && full > 0)
-            out.offer({full, t, from.cast<float>(), to.cast<float>()}, kDistinctAngle_deg,
+            out.offer({full, t, from.cast<float>(), to.cast<float>()}, centre, kDistinctAngle_deg,
                       kDistinctShiftDeltas * params.delta_m);
         }
       });
@@ -205,7 +199,8 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
   for (const Candidate& c : all) {
     if (static_cast<int>(result.hypotheses.size()) >= params.hypotheses_kept) break;
     const bool is_new = std::all_of(result.hypotheses.begin(), result.hypotheses.end(), [&](const Hypothesis& h) {
-      return distinct_transforms(h.transform, c.transform, kDistinctAngle_deg, kDistinctShiftDeltas * params.delta_m);
+      return distinct_transforms(h.transform, c.transform, centre, kDistinctAngle_deg,
+                                 kDistinctShiftDeltas * params.delta_m);
     });
     if (!is_new) continue;
     Hypothesis h;

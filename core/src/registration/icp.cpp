@@ -11,6 +11,7 @@
 
 #include "k4reg/geometry/neighbor_grid.h"
 #include "k4reg/geometry/rigid_fit.h"
+#include "k4reg/geometry/rigid_motion.h"
 #include "k4reg/geometry/voxel_grid.h"
 
 namespace k4reg {
@@ -36,24 +37,35 @@ std::vector<Eigen::Vector3f> downsample(const std::vector<Eigen::Vector3f>& poin
   return voxel_grid(cloud, voxel_m).cloud.points;
 }
 
-// One linearised point-to-plane step at the current transform (fixed grain: deterministic sums).
+// The source's centre (centre_m) and where a transform puts it: ICP turns the source about that point. About
+// the frame's origin instead, an origin metres from the scan would make every linearised rotation a large
+// translation, and float rounding of the moved points a step noise far above the convergence bar.
+struct Pivot {
+  Eigen::Vector3d centre_m, moved_m;
+  Pivot(const Eigen::Vector3d& centre, const Eigen::Matrix4d& t)
+      : centre_m(centre), moved_m(t.topLeftCorner<3, 3>() * centre + t.topRightCorner<3, 1>()) {}
+};
+
+// One linearised point-to-plane step at transform t (fixed grain: deterministic sums).
 Accumulation accumulate(const std::vector<Eigen::Vector3f>& source, const std::vector<Eigen::Vector3f>& target,
-                        const std::vector<Eigen::Vector3f>& normals, const NeighborGrid& grid, const Eigen::Affine3f& t,
-                        float max_distance, double kernel_m) {
+                        const std::vector<Eigen::Vector3f>& normals, const NeighborGrid& grid, const Eigen::Matrix4d& t,
+                        const Pivot& pivot, float max_distance, double kernel_m) {
   const double k2 = kernel_m * kernel_m;
+  const Eigen::Matrix3f rotation = t.topLeftCorner<3, 3>().cast<float>();
+  const Eigen::Vector3f centre = pivot.centre_m.cast<float>(), moved = pivot.moved_m.cast<float>();
   return tbb::parallel_deterministic_reduce(
       tbb::blocked_range<std::size_t>(0, source.size(), 2048), Accumulation{},
       [&](const tbb::blocked_range<std::size_t>& range, Accumulation acc) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          const Eigen::Vector3f p = t * source[i];
+          const Eigen::Vector3f arm = rotation * (source[i] - centre);  // from the moved centre
+          const Eigen::Vector3f p = moved + arm;
           const int j = grid.nearest_within(p, max_distance);
           if (j < 0 || normals[j].isZero()) continue;
           const Eigen::Vector3d n = normals[j].cast<double>();
-          const Eigen::Vector3d pd = p.cast<double>();
-          const double r = n.dot(pd - target[j].cast<double>());
+          const double r = n.dot(pivot.moved_m - target[j].cast<double>() + arm.cast<double>());
           const double w = 1.0 / ((1.0 + r * r / k2) * (1.0 + r * r / k2));  // Geman-McClure
           Eigen::Matrix<double, 6, 1> jac;
-          jac << pd.cross(n), n;
+          jac << arm.cast<double>().cross(n), n;
           acc.hessian += w * jac * jac.transpose();
           acc.gradient += w * r * jac;
           acc.squared_residuals += r * r;
@@ -158,11 +170,13 @@ IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const E
     const auto& tgt = target.stages[stage];
     const double voxel = tgt.voxel_m;
     const float max_distance = static_cast<float>(params.max_distance_factor * voxel);
+    const Eigen::Vector3d centre = centroid(src.points);
     result.converged = false;
     for (int it = 0; it < params.max_iterations; ++it) {
       check(cancel);
+      const Pivot pivot(centre, result.transform);
       const Accumulation acc =
-          accumulate(src.points, tgt.points, tgt.normals, *tgt.grid, to_affine3f(result.transform), max_distance, voxel);
+          accumulate(src.points, tgt.points, tgt.normals, *tgt.grid, result.transform, pivot, max_distance, voxel);
       ++result.iterations;
       if (acc.inliers < 6) break;
       const Eigen::Matrix<double, 6, 1> delta = solve_step(acc, params.levelled);
@@ -170,7 +184,7 @@ IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const E
       Eigen::Matrix4d step = Eigen::Matrix4d::Identity();
       const double angle = delta.head<3>().norm();
       if (angle > 0) step.topLeftCorner<3, 3>() = Eigen::AngleAxisd(angle, delta.head<3>() / angle).toRotationMatrix();
-      step.topRightCorner<3, 1>() = delta.tail<3>();
+      step.topRightCorner<3, 1>() = pivot.moved_m + delta.tail<3>() - step.topLeftCorner<3, 3>() * pivot.moved_m;
       result.transform = step * result.transform;
       if (angle < 1e-2 * params.converged_step_voxels && delta.tail<3>().norm() < params.converged_step_voxels * voxel) {
         result.converged = true;
@@ -178,8 +192,8 @@ IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const E
       }
     }
     if (stage + 1 == stages) {
-      const Accumulation acc =
-          accumulate(src.points, tgt.points, tgt.normals, *tgt.grid, to_affine3f(result.transform), max_distance, voxel);
+      const Accumulation acc = accumulate(src.points, tgt.points, tgt.normals, *tgt.grid, result.transform,
+                                          Pivot(centre, result.transform), max_distance, voxel);
       result.inliers = acc.inliers;
       result.translation_information = acc.hessian.bottomRightCorner<3, 3>();
       result.rmse_m = acc.inliers ? std::sqrt(acc.squared_residuals / acc.inliers) : 0.0;

@@ -24,6 +24,7 @@
 #include "k4reg/geometry/neighbor_grid.h"
 #include "k4reg/registration/pose_score.h"
 #include "k4reg/geometry/rigid_fit.h"
+#include "k4reg/geometry/rigid_motion.h"
 #include "k4reg/geometry/sampling.h"
 #include "k4reg/registration/surface_signal.h"
 #include "k4reg/registration/symmetry_guard.h"
@@ -178,9 +179,10 @@ constexpr std::size_t kMaxContenders = 3;
 constexpr std::size_t kContenderPoints = 15000;  // per ICP stage: a pose to well under a voxel
 
 // Whether two hypotheses nearly as well supported as the best (within the contender band) share a rotation
-// (within 5 degrees) but lie more than min_shift_m apart: the scene repeats under a shift. In a symmetric
-// room the rivals are turned copies of each other instead.
-bool repeats_under_a_shift(const std::vector<Hypothesis>& hypotheses, double min_shift_m) {
+// (within 5 degrees) but put the source's centre (centre_m) more than min_shift_m apart: the scene repeats under
+// a shift. In a symmetric room the rivals are turned copies of each other instead.
+bool repeats_under_a_shift(const std::vector<Hypothesis>& hypotheses, const Eigen::Vector3d& centre_m,
+                           double min_shift_m) {
   constexpr double kSameRotationDeg = 5.0;
   std::vector<const Eigen::Matrix4d*> leading;
   for (const Hypothesis& h : hypotheses)
@@ -189,8 +191,7 @@ bool repeats_under_a_shift(const std::vector<Hypothesis>& hypotheses, double min
     for (std::size_t j = i + 1; j < leading.size(); ++j) {
       const Eigen::Matrix4d &a = *leading[i], &b = *leading[j];
       const double angle_deg = rotation_angle_deg(a.topLeftCorner<3, 3>().transpose() * b.topLeftCorner<3, 3>());
-      if (angle_deg < kSameRotationDeg && (a.topRightCorner<3, 1>() - b.topRightCorner<3, 1>()).norm() > min_shift_m)
-        return true;
+      if (angle_deg < kSameRotationDeg && shift_at_m(a, b, centre_m) > min_shift_m) return true;
     }
   return false;
 }
@@ -247,6 +248,7 @@ Verdict judge_contenders(const SymmetryGuardResult& guarded, const IcpPyramid& s
   // Contenders refine on a thinned source, side by side (each sum is deterministic); the winner is then
   // polished on every point at the finest stage, which also gives its quality figures.
   const IcpPyramid contender_source = thin_pyramid(source, kContenderPoints);
+  const Eigen::Vector3d source_centre = centroid(source.stages.front().points);  // where poses are compared
   IcpParams contender_params = final_params;
   contender_params.converged_step_voxels = kSettledStepVoxels;
   std::vector<IcpResult> refined(contenders);
@@ -268,7 +270,8 @@ Verdict judge_contenders(const SymmetryGuardResult& guarded, const IcpPyramid& s
     });
     for (std::size_t i = 0; i < contenders; ++i)
       if (std::none_of(kept.begin(), kept.end(), [&](std::size_t k) {
-            return !distinct_transforms(hypotheses[k].transform, hypotheses[i].transform, 2.0, 2.0 * sigma);
+            return !distinct_transforms(hypotheses[k].transform, hypotheses[i].transform, source_centre, 2.0,
+                                        2.0 * sigma);
           }))
         kept.push_back(i);
     return 0;
@@ -515,7 +518,8 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   // doors every few metres), the truth may be a shifted copy that 4PCS did not find: the guard searches
   // wider, from the verdict's winner, and the verdict judges again. Only such pairs pay for it.
   if (params.icp && (verdict.margin < kAmbiguousMargin || verdict.disputed_by > 0.0) &&
-      repeats_under_a_shift(verdict.hypotheses, 2.0 * icp.second.stages.front().voxel_m)) {
+      repeats_under_a_shift(verdict.hypotheses, centroid(icp.first.stages.front().points),
+                            2.0 * icp.second.stages.front().voxel_m)) {
     const SymmetryGuardResult wider = timer.run("symmetry_guard", [&] {
       return rank_hypotheses(icp.first, icp.second, verdict.hypotheses, result.overlap_used, seen,
                              params.levelled, cancel, true);

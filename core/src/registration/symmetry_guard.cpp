@@ -14,6 +14,7 @@
 #include "k4reg/geometry/neighbor_grid.h"
 #include "k4reg/geometry/normal_space_sampling.h"
 #include "k4reg/geometry/rigid_fit.h"
+#include "k4reg/geometry/rigid_motion.h"
 #include "k4reg/registration/translation_vote.h"
 
 namespace k4reg {
@@ -163,6 +164,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   const auto& reference = target.stages.at(kStages - 1);
   const double voxel_m = reference.voxel_m;
   const float tau = static_cast<float>(1.5 * voxel_m);
+  const Eigen::Vector3d source_centre = centroid(source.stages.front().points);  // where poses are compared
   const NeighborGrid grid(reference.points, 2.0 * tau);  // 8-cell look-ups for the score
   IcpParams quick;
   quick.stages = kStages;
@@ -188,7 +190,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
     h.cloud_score = cloud_score(scored, reference, grid, tau, h.transform, views, overlap);
     if (!from_afar) return;
     const Eigen::Matrix4d pulled = refine_icp(wide_source, wide_target, start, wide, cancel).transform;
-    if (!distinct_transforms(pulled, h.transform, 1.0, target.stages.front().voxel_m)) return;  // same basin
+    if (!distinct_transforms(pulled, h.transform, source_centre, 1.0, target.stages.front().voxel_m)) return;  // same basin
     const Eigen::Matrix4d settled = refine_icp(settling_source, target, pulled, quick, cancel).transform;
     const double score = cloud_score(scored, reference, grid, tau, settled, views, overlap);
     if (score > h.cloud_score) {
@@ -239,7 +241,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
     // The first hypothesis after the best that is a distinct pose.
     auto first_rival = [&] {
       return std::find_if(hypotheses.begin() + 1, hypotheses.end(), [&](const Hypothesis& h) {
-        return distinct_transforms(hypotheses.front().transform, h.transform, 2.0, 2.0 * voxel_m);
+        return distinct_transforms(hypotheses.front().transform, h.transform, source_centre, 2.0, 2.0 * voxel_m);
       });
     };
     auto decisive = [&] {
@@ -259,7 +261,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
     std::vector<Eigen::Matrix4d> twinned, shifted;  // the bests expanded so far, each way
     auto among = [&](const std::vector<Eigen::Matrix4d>& done, const Eigen::Matrix4d& t) {
       return std::any_of(done.begin(), done.end(),
-                         [&](const Eigen::Matrix4d& d) { return !distinct_transforms(d, t, 2.0, 2.0 * voxel_m); });
+                         [&](const Eigen::Matrix4d& d) { return !distinct_transforms(d, t, source_centre, 2.0, 2.0 * voxel_m); });
     };
     for (int round = 0; round < (periodic ? kMaxRounds : 1); ++round) {
       const Eigen::Matrix4d best = hypotheses.front().transform;
@@ -304,7 +306,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   // Hypotheses that ICP brought to the same pose are one hypothesis.
   for (const Hypothesis& h : hypotheses)
     if (std::all_of(result.hypotheses.begin(), result.hypotheses.end(), [&](const Hypothesis& d) {
-          return distinct_transforms(d.transform, h.transform, 2.0, 2.0 * voxel_m);
+          return distinct_transforms(d.transform, h.transform, source_centre, 2.0, 2.0 * voxel_m);
         }))
       result.hypotheses.push_back(h);
   const auto& ranked = result.hypotheses;

@@ -1,8 +1,10 @@
-// Small rigid-motion helpers for pose graphs and loop checks: the exponential and logarithm of rotations
-// (axis-angle vectors) and how far a transform moves the points of a scan. Cost: O(1) each.
+// Small rigid-motion helpers for pose graphs, loop checks and hypothesis lists: the exponential and logarithm
+// of rotations (axis-angle vectors), how far a transform moves the points of a scan, and whether two poses
+// differ. Cost: O(1) each (centroid: O(n)).
 #pragma once
 
 #include <Eigen/Core>
+#include <vector>
 
 namespace k4reg {
 
@@ -16,6 +18,18 @@ Eigen::Vector3d rotation_log(const Eigen::Matrix3d& r);
 // the frame's origin, in metres: sqrt(|t|^2 + (lever_arm_m * angle)^2). One number for rotation and
 // translation, in the units a user judges a registration by.
 double displacement_m(const Eigen::Matrix4d& t, double lever_arm_m);
+
+// How far apart two poses put the point at_m (in the posed scan's own frame).
+double shift_at_m(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b, const Eigen::Vector3d& at_m);
+
+// Whether two poses of one scan differ: by at least min_angle_deg, or by putting the point at_m (the scan's
+// centre, in its own frame) at least min_shift_m apart. Compared at the scan rather than at its frame's origin:
+// an origin tens of metres away turns a fraction of a degree into centimetres of translation.
+bool distinct_transforms(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b, const Eigen::Vector3d& at_m,
+                         double min_angle_deg, double min_shift_m);
+
+// The mean of the points, in double (zero for none): the centre poses are compared and rotated about.
+Eigen::Vector3d centroid(const std::vector<Eigen::Vector3f>& points);
 
 // The inverse of a rigid transform.
 Eigen::Matrix4d rigid_inverse(const Eigen::Matrix4d& t);

@@ -44,8 +44,4 @@ FourPcsResult match_4pcs(const std::vector<Eigen::Vector3f>& source, const std::
                          const FourPcsParams& params, const CancellationToken* cancel = nullptr,
                          const ProgressCallback& progress = {});
 
-// True when two transforms differ by at least min_angle_deg or min_translation_m.
-bool distinct_transforms(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b, double min_angle_deg,
-                         double min_translation_m);
-
 }  // namespace k4reg
