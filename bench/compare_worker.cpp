@@ -13,7 +13,6 @@
 #include <Eigen/Geometry>
 #include <sys/resource.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -24,6 +23,7 @@
 #include "k4reg/io/cloud_io.h"
 #include "k4reg/registration/dog_keypoints.h"
 #include "k4reg/util/error.h"
+#include "k4reg/util/stopwatch.h"
 #include "k4reg/registration/four_pcs.h"
 #include "k4reg/registration/metrics.h"
 #include "k4reg/geometry/neighbor_grid.h"
@@ -37,7 +37,6 @@
 namespace k4reg::bench {
 
 using nlohmann::json;
-using Clock = std::chrono::steady_clock;
 
 void to_json(json& j, const Job& job) {
   j = json{{"method", job.method},       {"source", job.source},       {"target", job.target},
@@ -85,8 +84,6 @@ std::string scan_key(const std::string& file, const Job& job, std::uint64_t pose
                 static_cast<unsigned long long>(pose_seed));
   return file + buffer;
 }
-
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 Eigen::Matrix4d translation(const Eigen::Vector3d& t) {
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
@@ -151,7 +148,7 @@ PointCloud moved(const PointCloud& cloud, const Eigen::Matrix4d& pose) {
 
 LoadedPair load_pair(const Job& job) {
   LoadedPair pair;
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   PointCloud source = read_cloud(job.source), target = read_cloud(job.target);
   pair.read_s = seconds_since(start);
   pair.source = conditioned(std::move(source), job.unit_scale, job.max_range_m);
@@ -223,7 +220,7 @@ void run_ours(const Job& job, const LoadedPair& pair, json& out) {
     params.method = CoarseMethod::kPlain4pcs;
     params.plain_voxel_m = job.plain_voxel_m;
   }
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   const RegistrationResult r = register_clouds(pair.source, pair.target, params);
   out["total_s"] = seconds_since(start);
   out["stages"] = stage_times(r.timings);
@@ -249,11 +246,11 @@ void run_pcl(const Job& job, const LoadedPair& pair, json& out) {
     source_set = pcl_points(sift.source.points), target_set = pcl_points(sift.target.points);
     stages["keypoints"] = sift.seconds();
   } else {
-    auto start = Clock::now();
+    auto start = SteadyClock::now();
     const PclCloud::Ptr source = to_pcl(pair.source), target = to_pcl(pair.target);
     out["convert_s"] = seconds_since(start);
     delta = job.plain_voxel_m;
-    start = Clock::now();
+    start = SteadyClock::now();
     source_set = pcl_voxel_grid(source, delta), target_set = pcl_voxel_grid(target, delta);
     out["voxel_grid_overflow"] = pcl_voxel_grid_overflows(*source, delta) || pcl_voxel_grid_overflows(*target, delta);
     stages["plain_grid"] = seconds_since(start);
@@ -262,7 +259,7 @@ void run_pcl(const Job& job, const LoadedPair& pair, json& out) {
   out["target_keypoints"] = target_set->size();
   if (source_set->size() < 4 || target_set->size() < 4) fail(ErrorCode::kFailedPrecondition, "too few keypoints");
 
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   const PclAlignParams params = pcl_align_params(job, delta);
   const Eigen::Matrix4d local = job.method == kPclK4pcs ? pcl_kfpcs(source_set, target_set, params)
                                                        : pcl_fpcs(source_set, target_set, params);
@@ -279,7 +276,7 @@ void run_pcl(const Job& job, const LoadedPair& pair, json& out) {
 
 // ETH office: the clouds are keypoints already; only the 4PCS stage runs.
 void run_match(const Job& job, const LoadedPair& pair, json& out) {
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   Eigen::Matrix4d local;
   if (job.method == kOursMatch) {
     FourPcsParams params{job.sigma_m, job.overlap, job.max_bases};
@@ -333,7 +330,7 @@ void run_keypoints(const Job& job, const LoadedPair& pair, json& out) {
   const Eigen::Matrix4d truth_local = local_from_file(pair.truth, pair.source, pair.target);
   std::vector<Eigen::Vector3f> source, target;
   if (job.method == kKeypointsOurs) {
-    const auto start = Clock::now();
+    const auto start = SteadyClock::now();
     source = our_keypoints(pair.source, intensity, sigma);
     target = our_keypoints(pair.target, intensity, sigma);
     out["seconds"] = seconds_since(start);

@@ -8,7 +8,6 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -21,14 +20,13 @@
 #include "k4reg/io/las_io.h"
 #include "k4reg/io/ply_io.h"
 #include "k4reg/io/ptx_io.h"
+#include "k4reg/util/stopwatch.h"
 
 namespace fs = std::filesystem;
+using k4reg::seconds_since;
+using k4reg::SteadyClock;
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 k4reg::PointCloud survey_cloud(std::size_t n) {
   k4reg::PointCloud cloud;
@@ -93,13 +91,13 @@ int main(int argc, char** argv) {
   std::printf("| format | file MB | write s | read s (median of %d) | M points/s |\n|---|---|---|---|---|\n", repeats);
   for (const Format& format : formats) {
     const std::string path = (fs::path(dir) / (std::string("k4reg-bench-read-") + format.file)).string();
-    auto start = Clock::now();
+    auto start = SteadyClock::now();
     format.write(path, cloud);
     const double write_s = seconds_since(start);
     std::size_t read_points = k4reg::read_cloud(path).size();  // loads the page cache
     std::vector<double> times;
     for (int r = 0; r < repeats; ++r) {
-      start = Clock::now();
+      start = SteadyClock::now();
       read_points = k4reg::read_cloud(path).size();
       times.push_back(seconds_since(start));
     }

@@ -1,6 +1,5 @@
 #include "project_job.h"
 
-#include <chrono>
 
 #include <fmt/format.h>
 
@@ -8,6 +7,7 @@
 
 #include "cloud_bytes.h"
 #include "k4reg/util/error.h"
+#include "k4reg/util/stopwatch.h"
 #include "peer_pair_runner.h"
 #include "project_convert.h"
 #include "proto_convert.h"
@@ -15,10 +15,6 @@
 
 namespace k4reg::service {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 }  // namespace
 
@@ -28,7 +24,7 @@ ProjectOutcome run_project(const std::vector<CloudSource>& scans, const std::vec
                            const PairListener& pairs, PairRunner* runner, ProjectReport& report) {
   token.throw_if_stopped();  // cancelled or expired while queued
   StageTracker progress(stages);
-  const auto load_start = Clock::now();
+  const auto load_start = SteadyClock::now();
   progress("load", 0.0);
   const ReadOptions options{limits.max_points};
   std::vector<CloudBytes> bytes;
@@ -53,7 +49,7 @@ ProjectOutcome run_project(const std::vector<CloudSource>& scans, const std::vec
   report.load_s = seconds_since(load_start);
 
   if (params.pairwise.threads == 0 || params.pairwise.threads > limits.job_threads) params.pairwise.threads = limits.job_threads;
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   const ProgressCallback callback = [&](const std::string& stage, double fraction) { progress(stage, fraction); };
   ProjectOutcome outcome{register_project(clouds, params, &token, callback, pairs, runner), std::nullopt};
   report.registration_s = seconds_since(start);

@@ -1,7 +1,6 @@
 #include "registration_job.h"
 
 #include <algorithm>
-#include <chrono>
 
 #include <fmt/format.h>
 
@@ -9,13 +8,10 @@
 #include "k4reg/io/cloud_io.h"
 #include "k4reg/io/declared_points.h"
 #include "k4reg/util/error.h"
+#include "k4reg/util/stopwatch.h"
 
 namespace k4reg::service {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 }  // namespace
 
@@ -85,7 +81,7 @@ RegistrationOutcome run_registration(const CloudSource& source, const CloudSourc
   token.throw_if_stopped();  // cancelled or expired while queued
   StageTracker progress(listener);
 
-  const auto load_start = Clock::now();
+  const auto load_start = SteadyClock::now();
   progress("load", 0.0);
   const ReadOptions options{limits.max_points};
   const CloudBytes source_bytes(source), target_bytes(target);
@@ -102,7 +98,7 @@ RegistrationOutcome run_registration(const CloudSource& source, const CloudSourc
   report.load_s = seconds_since(load_start);
 
   if (params.threads == 0 || params.threads > limits.job_threads) params.threads = limits.job_threads;
-  const auto start = Clock::now();
+  const auto start = SteadyClock::now();
   const ProgressCallback callback = [&](const std::string& stage, double fraction) { progress(stage, fraction); };
   RegistrationOutcome outcome{register_clouds(source_cloud, target_cloud, params, &token, callback), std::nullopt};
   report.registration_s = seconds_since(start);

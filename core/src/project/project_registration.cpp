@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <optional>
 #include <tuple>
@@ -20,21 +19,10 @@
 #include "k4reg/registration/translation_constraint.h"
 #include "k4reg/util/error.h"
 #include "k4reg/util/median.h"
+#include "k4reg/util/stopwatch.h"
 
 namespace k4reg {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-void add_timing(std::vector<StageTiming>& timings, const std::string& stage, double seconds) {
-  auto same = std::find_if(timings.begin(), timings.end(), [&](const StageTiming& t) { return t.stage == stage; });
-  if (same != timings.end())
-    same->seconds += seconds;
-  else
-    timings.push_back({stage, seconds});
-}
 
 // A scan's radius about its frame's origin (the scanner, for terrestrial scans): how far a rotation error
 // moves its points. Robust to stray far returns: half the robust diameter, or the distance to it.
@@ -45,7 +33,6 @@ double scan_radius_m(const PointCloud& cloud) {
   centre = centre / static_cast<double>(cloud.points.size()) + cloud.origin_m;
   return std::max(half, centre.norm() + half);
 }
-
 
 // The pose of scan `scan` that a link to an already placed scan proposes.
 Eigen::Matrix4d proposed_pose(const ProjectResult& r, const ProjectLink& link, std::size_t scan) {
@@ -206,8 +193,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
 
   CancellationToken budget(cancel);
   if (params.pairwise.time_budget_s > 0)
-    budget.set_deadline(Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(params.pairwise.time_budget_s)));
+    budget.set_deadline(deadline_in(params.pairwise.time_budget_s));
   RegistrationParams pairwise = params.pairwise;
   pairwise.time_budget_s = 0.0;  // the project's deadline covers every pair
   pairwise.search_other_side = false;  // the project's own rule below, for the pairs of scans no loop confirms
@@ -229,7 +215,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
   std::vector<ScanPair> pairs;
   std::vector<double> estimates;
   if (r.pairs_used == PairSelection::kScreened) {
-    const auto screen_start = Clock::now();
+    const auto screen_start = SteadyClock::now();
     estimates = estimate_overlaps(prepared, pairwise, &budget, progress);
     pairs = best_partners(scans.size(), estimates, params.partners);
     r.pairs_screened = estimates.size();
@@ -310,7 +296,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
 
   // 2a. Weak links judged from both sides: a well-supported winner with a small margin, and its runner-up, are
   //     judged again with the scans swapped, and the two sides' margins add up (two_sided_margin.h).
-  auto start = Clock::now();
+  auto start = SteadyClock::now();
   for (std::size_t l = 0; l < r.links.size(); ++l) {
     const LinkCandidates& c = candidates[l];
     if (c.transforms.size() < 2 || !c.well_supported || c.margin >= kAmbiguousMargin) continue;
@@ -334,11 +320,11 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
   // 2. One candidate per link, so that the loops close. Where a loop stays open, the pose its other two links
   //    imply for a link is judged on the link's own clouds (the pair's 4PCS may have missed the truth), and the
   //    loops choose again.
-  start = Clock::now();
+  start = SteadyClock::now();
   const LoopSelectionResult first = select_loop_consistent(candidates, radius);
   const std::vector<std::vector<Eigen::Matrix4d>> implied = poses_implied_by_open_loops(candidates, first, radius);
   add_timing(r.timings, "selection", seconds_since(start));
-  start = Clock::now();
+  start = SteadyClock::now();
   for (std::size_t l = 0; l < r.links.size(); ++l) {
     if (implied[l].empty()) continue;
     check(&budget);
@@ -351,7 +337,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     std::vector<Eigen::Matrix4d> poses{candidates[l].transforms.front()};
     poses.insert(poses.end(), implied[l].begin(), implied[l].end());
     PairOutcome outcome;
-    const auto judge_start = Clock::now();
+    const auto judge_start = SteadyClock::now();
     try {
       outcome.result = judge_poses(prepared[s], prepared[t], judge, poses, &budget);
     } catch (const Error& e) {
@@ -369,7 +355,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     r.links[l].loop_pose_won = judgement == LoopPoseJudgement::kImpliedWon;
   }
   add_timing(r.timings, "loop_poses", seconds_since(start));
-  start = Clock::now();
+  start = SteadyClock::now();
   const LoopSelectionResult selection = select_loop_consistent(candidates, radius);
   r.loops_checked = selection.loops_checked;
   r.loops_inconsistent = selection.loops_inconsistent;
@@ -423,7 +409,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
 
   // 3. Initial poses by consensus, then all poses together over the accepted links that agree with them. A
   //    link the refined project contradicts by more than its loop tolerance is dropped and all solved again.
-  start = Clock::now();
+  start = SteadyClock::now();
   if (progress) progress("refinement", 0.0);
   for (;;) {
     check(&budget);

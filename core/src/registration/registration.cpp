@@ -6,7 +6,6 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -17,6 +16,7 @@
 #include "k4reg/registration/fine_polish.h"
 #include "k4reg/registration/prepared_scan.h"
 #include "k4reg/util/error.h"
+#include "k4reg/util/stopwatch.h"
 #include "k4reg/registration/four_pcs.h"
 #include "k4reg/registration/free_space.h"
 #include "k4reg/registration/icp.h"
@@ -34,24 +34,15 @@
 namespace k4reg {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 class StageTimer {
  public:
   StageTimer(RegistrationResult& result, const ProgressCallback& progress) : result_(result), progress_(progress) {}
   template <typename F>
   auto run(const std::string& stage, F&& f) {
     if (progress_) progress_(stage, 0.0);
-    const auto start = Clock::now();
+    const auto start = SteadyClock::now();
     auto value = f();
-    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    // A stage run twice (the geometric fallback) reports its total.
-    auto same = std::find_if(result_.timings.begin(), result_.timings.end(),
-                             [&](const StageTiming& t) { return t.stage == stage; });
-    if (same != result_.timings.end())
-      same->seconds += seconds;
-    else
-      result_.timings.push_back({stage, seconds});
+    add_timing(result_.timings, stage, seconds_since(start));
     if (progress_) progress_(stage, 1.0);
     return value;
   }
@@ -621,13 +612,7 @@ class ScaleLadder {
 
 // Stage timings of two attempts added up, stage by stage.
 void add_timings(std::vector<StageTiming>& total, const std::vector<StageTiming>& more) {
-  for (const StageTiming& t : more) {
-    auto same = std::find_if(total.begin(), total.end(), [&](const StageTiming& s) { return s.stage == t.stage; });
-    if (same != total.end())
-      same->seconds += t.seconds;
-    else
-      total.push_back(t);
-  }
+  for (const StageTiming& t : more) add_timing(total, t.stage, t.seconds);
 }
 
 // Where a scale finds no well-supported pose: the search from the other side. 4PCS draws its bases in the
@@ -703,6 +688,14 @@ RegistrationResult run(const PreparedScan& source, const PreparedScan& target, c
 
 }  // namespace
 
+void add_timing(std::vector<StageTiming>& timings, const std::string& stage, double seconds) {
+  auto same = std::find_if(timings.begin(), timings.end(), [&](const StageTiming& t) { return t.stage == stage; });
+  if (same != timings.end())
+    same->seconds += seconds;
+  else
+    timings.push_back({stage, seconds});
+}
+
 double starting_scale_m(const PreparedScan& source, const PreparedScan& target, double min_scale_m) {
   if (min_scale_m > 0.0) return min_scale_m;
   const Sampling &s = source.sampling(), &t = target.sampling();
@@ -742,8 +735,7 @@ RegistrationResult register_clouds(const PreparedScan& source, const PreparedSca
   // A time budget becomes a deadline on a private token that also follows the caller's cancellation.
   CancellationToken budget(cancel);
   if (params.time_budget_s > 0)
-    budget.set_deadline(Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(params.time_budget_s)));
+    budget.set_deadline(deadline_in(params.time_budget_s));
   tbb::task_arena arena(params.threads > 0 ? params.threads : tbb::task_arena::automatic);
   RegistrationResult result;
   arena.execute([&] { result = run(source, target, params, &budget, progress); });

@@ -354,11 +354,18 @@ namespace {
 constexpr double kMinScannerRange = 1.0;  // a terrestrial scanner's median range, at least
 }  // namespace
 
+namespace {
+
+Eigen::AlignedBox3f bounds(const std::vector<Eigen::Vector3f>& points) {
+  Eigen::AlignedBox3f box;
+  for (const Eigen::Vector3f& p : points) box.extend(p);
+  return box;
+}
+
+}  // namespace
+
 bool surrounded_by(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& at) {
-  if (points.empty()) return false;
-  Eigen::Vector3f low = points.front(), high = points.front();
-  for (const Eigen::Vector3f& p : points) low = low.cwiseMin(p), high = high.cwiseMax(p);
-  if (!((at.array() >= low.array()).all() && (at.array() <= high.array()).all())) return false;
+  if (points.empty() || !bounds(points).contains(at)) return false;
   std::vector<double> ranges;
   ranges.reserve(points.size());
   for (const Eigen::Vector3f& p : points) ranges.push_back((p - at).norm());
@@ -366,10 +373,7 @@ bool surrounded_by(const std::vector<Eigen::Vector3f>& points, const Eigen::Vect
 }
 
 bool could_surround_a_scanner(const std::vector<Eigen::Vector3f>& points) {
-  if (points.empty()) return false;
-  Eigen::Vector3f low = points.front(), high = points.front();
-  for (const Eigen::Vector3f& p : points) low = low.cwiseMin(p), high = high.cwiseMax(p);
-  return (high - low).norm() >= kMinScannerRange;
+  return !points.empty() && bounds(points).diagonal().norm() >= kMinScannerRange;
 }
 
 namespace {

@@ -110,6 +110,9 @@ struct StageTiming {
   double seconds = 0.0;
 };
 
+// Adds seconds to the stage's entry (appended where the stage is new): a stage run more than once reports its total.
+void add_timing(std::vector<StageTiming>& timings, const std::string& stage, double seconds);
+
 struct RegistrationResult {
   Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();  // source -> target, in the files' frames
   double rmse_m = 0.0;          // RMS of the inlier residuals after refinement
