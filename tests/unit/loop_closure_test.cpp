@@ -9,6 +9,9 @@
 namespace k4reg {
 namespace {
 
+// Scans about their frames' origins, 10 m across.
+const ScanExtent kTenMetres{Eigen::Vector3d::Zero(), 10.0};
+
 Eigen::Matrix4d pose(double yaw, const Eigen::Vector3d& t) {
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
   m.topLeftCorner<3, 3>() = rotation_exp(Eigen::Vector3d(0, 0, yaw));
@@ -21,7 +24,7 @@ const Eigen::Matrix4d kFlip = pose(3.14159265, Eigen::Vector3d(10, 0, 0));
 
 struct Project {
   std::vector<Eigen::Matrix4d> truth{pose(0, {0, 0, 0}), pose(0.7, {2, 1, 0}), pose(1.9, {4, -1, 0.1}), pose(-2.5, {1, 3, 0})};
-  std::vector<double> radius = std::vector<double>(4, 10.0);
+  std::vector<ScanExtent> radius = std::vector<ScanExtent>(4, kTenMetres);
   // source -> target under the truth
   Eigen::Matrix4d relative(std::size_t s, std::size_t t) const { return rigid_inverse(truth[t]) * truth[s]; }
   std::vector<LinkCandidates> all_pairs() const {
@@ -158,10 +161,10 @@ TEST(LoopClosure, OpenLoopsImplyTheirLinksPosesFromTheOtherTwo) {
   ASSERT_EQ(implied.size(), links.size());
   // 0 -> 2 lies in triangles 0-1-2 and 0-2-3, each of which implies the truth once (then it is known).
   ASSERT_EQ(implied[1].size(), 1u);
-  EXPECT_LT(displacement_m(rigid_inverse(p.relative(0, 2)) * implied[1][0], 10.0), 1e-9);
+  EXPECT_LT(displacement_m(rigid_inverse(p.relative(0, 2)) * implied[1][0], kTenMetres), 1e-9);
   // The other links of those open triangles are offered poses made with the flip, never the truth they have.
   for (std::size_t l : {0, 3, 2, 5})
-    for (const Eigen::Matrix4d& pose : implied[l]) EXPECT_GT(displacement_m(rigid_inverse(p.relative(links[l].source, links[l].target)) * pose, 10.0), 1.0);
+    for (const Eigen::Matrix4d& pose : implied[l]) EXPECT_GT(displacement_m(rigid_inverse(p.relative(links[l].source, links[l].target)) * pose, kTenMetres), 1.0);
   EXPECT_TRUE(implied[4].empty());  // 1 -> 3: its triangle 1-2-3 closes
 
   const auto closed = poses_implied_by_open_loops(p.all_pairs(), select_loop_consistent(p.all_pairs(), p.radius), p.radius);
@@ -185,7 +188,7 @@ TEST(LoopClosure, LoopsClosedOnlyThroughARunnerUpImplyWhatTheWinnersGive) {
   ASSERT_EQ(selection.links[0].candidate, 1);  // the loop closes through the runner-up
   const std::vector<std::vector<Eigen::Matrix4d>> implied = poses_implied_by_open_loops(links, selection, p.radius);
   ASSERT_EQ(implied[2].size(), 1u);
-  EXPECT_LT(displacement_m(rigid_inverse(p.relative(1, 2)) * implied[2][0], 10.0), 1e-9);
+  EXPECT_LT(displacement_m(rigid_inverse(p.relative(1, 2)) * implied[2][0], kTenMetres), 1e-9);
   EXPECT_TRUE(implied[0].empty());  // what the other two winners imply for 0 -> 1 is its runner-up: known
   EXPECT_EQ(implied[1].size(), 1u);  // 0 -> 2 is offered the turned pose, for its clouds to reject
 

@@ -10,6 +10,9 @@
 namespace k4reg {
 namespace {
 
+// Scans about their frames' origins, 10 m across.
+const ScanExtent kAtOrigin10m{Eigen::Vector3d::Zero(), 10.0};
+
 Eigen::Matrix4d pose(const Eigen::Vector3d& w, const Eigen::Vector3d& t) {
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
   m.topLeftCorner<3, 3>() = rotation_exp(w);
@@ -28,13 +31,13 @@ struct Ring {
     for (int i = 1; i < 5; ++i)
       truth.push_back(pose(Eigen::Vector3d(0.1 * n(rng), 0.1 * n(rng), 1.2 * i), Eigen::Vector3d(3 * n(rng), 3 * n(rng), n(rng))));
     for (std::size_t a = 0; a < 5; ++a)
-      for (std::size_t b = a + 1; b < 5; ++b) links.push_back({a, b, rigid_inverse(truth[b]) * truth[a], 10.0, 1.0});
+      for (std::size_t b = a + 1; b < 5; ++b) links.push_back({a, b, rigid_inverse(truth[b]) * truth[a], kAtOrigin10m, 1.0});
   }
 };
 
 double max_error_m(const std::vector<Eigen::Matrix4d>& poses, const std::vector<Eigen::Matrix4d>& truth) {
   double worst = 0;
-  for (std::size_t i = 0; i < poses.size(); ++i) worst = std::max(worst, displacement_m(rigid_inverse(truth[i]) * poses[i], 10.0));
+  for (std::size_t i = 0; i < poses.size(); ++i) worst = std::max(worst, displacement_m(rigid_inverse(truth[i]) * poses[i], kAtOrigin10m));
   return worst;
 }
 

@@ -33,14 +33,14 @@ ProjectResult placed_project() {
 
 TEST(ScanConflicts, AgreeingLinksRefuseNothing) {
   ProjectResult r = placed_project();
-  refuse_conflicted_scans(r, std::vector<double>(3, 10.0));
+  refuse_conflicted_scans(r, std::vector<ScanExtent>(3, {Eigen::Vector3d::Zero(), 10.0}));
   for (const ProjectScan& s : r.scans) EXPECT_TRUE(s.registered);
 }
 
 TEST(ScanConflicts, ConfidentRejectedLinkThatDisagreesRefusesBothScansButTheReference) {
   ProjectResult r = placed_project();
   r.links[2].transform = shifted(1.0) * r.links[2].transform;  // 1 m off, confident
-  refuse_conflicted_scans(r, std::vector<double>(3, 10.0));
+  refuse_conflicted_scans(r, std::vector<ScanExtent>(3, {Eigen::Vector3d::Zero(), 10.0}));
   EXPECT_TRUE(r.scans[0].registered);  // the reference
   EXPECT_TRUE(r.scans[1].registered);
   EXPECT_FALSE(r.scans[2].registered);
@@ -58,7 +58,7 @@ TEST(ScanConflicts, AScanItsAcceptedLinksHoldMoreFirmlyThanTheContradictingOnesS
   extra.transform = rigid_inverse(r.scans[3].pose) * r.scans[2].pose;
   r.links.push_back(extra);
   r.links[2].transform = shifted(1.0) * r.links[2].transform;  // 1 m off, confident
-  refuse_conflicted_scans(r, std::vector<double>(4, 10.0));
+  refuse_conflicted_scans(r, std::vector<ScanExtent>(4, {Eigen::Vector3d::Zero(), 10.0}));
   for (const ProjectScan& s : r.scans) EXPECT_TRUE(s.registered) << s.reason;
 }
 
@@ -70,7 +70,7 @@ TEST(ScanConflicts, DoubtfulOrAcceptedOrSmallMisfitsRefuseNothing) {
     if (variant == 0) link.ambiguous = true;
     if (variant == 1) link.well_supported = false;
     if (variant == 2) link.accepted = true;
-    refuse_conflicted_scans(r, std::vector<double>(3, 10.0));
+    refuse_conflicted_scans(r, std::vector<ScanExtent>(3, {Eigen::Vector3d::Zero(), 10.0}));
     for (const ProjectScan& s : r.scans) EXPECT_TRUE(s.registered) << variant;
   }
 }

@@ -32,7 +32,7 @@ const Eigen::Matrix4d kAlongX = half_turn(Eigen::Vector3d::UnitX());
 struct HallProject {
   ProjectResult project;
   std::vector<LinkCandidates> candidates;
-  std::vector<double> radius_m = std::vector<double>(4, 15.0);
+  std::vector<ScanExtent> radius_m = std::vector<ScanExtent>(4, {Eigen::Vector3d::Zero(), 15.0});
 
   // floor_on_ceiling_close: that turn scores nearly as the truth on all three of station 0's links.
   explicit HallProject(bool floor_on_ceiling_close = false) {

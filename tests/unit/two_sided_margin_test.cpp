@@ -40,7 +40,7 @@ TEST_F(HallOppositeCorners, TargetsSideTurnsATieIntoTheTruthWhicheverCandidateCa
   params.overlap = 0.4;
   params.seed = 1;
   const RegistrationResult pair = register_clouds(source, target, params);
-  const std::vector<double> radius{20.0, 20.0};
+  const std::vector<ScanExtent> radius(2, ScanExtent{Eigen::Vector3d::Zero(), 20.0});
   auto error_m = [&](const Eigen::Matrix4d& t) { return displacement_m(rigid_inverse(truth()) * t, radius[0]); };
   const Hypothesis *true_pose = nullptr, *half_turn = nullptr;
   for (const Hypothesis& h : pair.hypotheses) {

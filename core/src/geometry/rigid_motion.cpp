@@ -16,15 +16,16 @@ Eigen::Vector3d rotation_log(const Eigen::Matrix3d& r) {
   return aa.angle() * aa.axis();
 }
 
-double displacement_m(const Eigen::Matrix4d& t, double lever_arm_m) {
-  const double angle = Eigen::AngleAxisd(Eigen::Matrix3d(t.topLeftCorner<3, 3>())).angle();
-  const double shift = t.topRightCorner<3, 1>().norm();
-  return std::sqrt(shift * shift + lever_arm_m * angle * lever_arm_m * angle);
-}
-
 double shift_at_m(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b, const Eigen::Vector3d& at_m) {
   const Eigen::Matrix4d d = a - b;
   return (d.topLeftCorner<3, 3>() * at_m + d.topRightCorner<3, 1>()).norm();
+}
+
+double displacement_m(const Eigen::Matrix4d& t, const ScanExtent& scan) {
+  const double angle = Eigen::AngleAxisd(Eigen::Matrix3d(t.topLeftCorner<3, 3>())).angle();
+  const double shift = shift_at_m(t, Eigen::Matrix4d::Identity(), scan.centre_m);
+  const double turn = scan.radius_m * angle;
+  return std::sqrt(shift * shift + turn * turn);
 }
 
 bool distinct_transforms(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b, const Eigen::Vector3d& at_m,

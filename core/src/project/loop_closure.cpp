@@ -46,7 +46,7 @@ std::vector<Triangle> find_triangles(const std::vector<LinkCandidates>& links) {
 
 // A triangle's residual (metres of displacement where it starts) and tolerance with the candidates `picks`.
 std::pair<double, double> loop_residual(const std::vector<LinkCandidates>& links, const Triangle& tri,
-                                        const std::array<int, 3>& picks, const std::vector<double>& scan_radius_m) {
+                                        const std::array<int, 3>& picks, const std::vector<ScanExtent>& extents) {
   Eigen::Matrix4d loop = Eigen::Matrix4d::Identity();
   double tolerance_sq = 0.0;
   for (int k = 0; k < 3; ++k) {
@@ -55,20 +55,20 @@ std::pair<double, double> loop_residual(const std::vector<LinkCandidates>& links
     loop = (tri.inverted[k] ? rigid_inverse(t) : t) * loop;
     tolerance_sq += link.tolerance_m * link.tolerance_m;
   }
-  return {displacement_m(loop, scan_radius_m.at(tri.start)), kLoopToleranceFactor * std::sqrt(tolerance_sq)};
+  return {displacement_m(loop, extents.at(tri.start)), kLoopToleranceFactor * std::sqrt(tolerance_sq)};
 }
 
 }  // namespace
 
 std::vector<std::vector<Eigen::Matrix4d>> poses_implied_by_open_loops(const std::vector<LinkCandidates>& links,
                                                                      const LoopSelectionResult& selection,
-                                                                     const std::vector<double>& scan_radius_m) {
+                                                                     const std::vector<ScanExtent>& extents) {
   auto pick = [&](std::size_t l) {
     return selection.links.at(l).candidate >= 0 ? selection.links[l].candidate : links[l].transforms.empty() ? -1 : 0;
   };
   std::vector<std::vector<Eigen::Matrix4d>> implied(links.size());
   auto known = [&](std::size_t l, const Eigen::Matrix4d& pose) {
-    auto near = [&](const Eigen::Matrix4d& t) { return within_loop_tolerance(links[l], t, pose, scan_radius_m); };
+    auto near = [&](const Eigen::Matrix4d& t) { return within_loop_tolerance(links[l], t, pose, extents); };
     return std::any_of(links[l].transforms.begin(), links[l].transforms.end(), near) ||
            std::any_of(implied[l].begin(), implied[l].end(), near);
   };
@@ -88,7 +88,7 @@ std::vector<std::vector<Eigen::Matrix4d>> poses_implied_by_open_loops(const std:
     }
   };
   auto closes = [&](const Triangle& tri, const std::array<int, 3>& picks) {
-    const auto [r, tol] = loop_residual(links, tri, picks, scan_radius_m);
+    const auto [r, tol] = loop_residual(links, tri, picks, extents);
     return r <= tol;
   };
   for (const Triangle& tri : find_triangles(links)) {
@@ -105,18 +105,18 @@ std::vector<std::vector<Eigen::Matrix4d>> poses_implied_by_open_loops(const std:
 }
 
 bool within_loop_tolerance(const LinkCandidates& link, const Eigen::Matrix4d& a, const Eigen::Matrix4d& b,
-                           const std::vector<double>& scan_radius_m) {
-  return displacement_m(rigid_inverse(a) * b, scan_radius_m.at(link.source)) <= kLoopToleranceFactor * link.tolerance_m;
+                           const std::vector<ScanExtent>& extents) {
+  return displacement_m(rigid_inverse(a) * b, extents.at(link.source)) <= kLoopToleranceFactor * link.tolerance_m;
 }
 
 LoopPoseJudgement judge_implied_poses(const LinkCandidates& link, const std::vector<Eigen::Matrix4d>& implied,
-                                      const RegistrationResult& judged, const std::vector<double>& scan_radius_m) {
+                                      const RegistrationResult& judged, const std::vector<ScanExtent>& extents) {
   auto implied_pose = [&](const Eigen::Matrix4d& t) {
     return std::any_of(implied.begin(), implied.end(),
-                       [&](const Eigen::Matrix4d& p) { return within_loop_tolerance(link, p, t, scan_radius_m); });
+                       [&](const Eigen::Matrix4d& p) { return within_loop_tolerance(link, p, t, extents); });
   };
   if (link.transforms.empty() || judged.hypotheses.empty()) return LoopPoseJudgement::kWinnerStands;
-  if (implied_pose(judged.transform) && !within_loop_tolerance(link, link.transforms.front(), judged.transform, scan_radius_m))
+  if (implied_pose(judged.transform) && !within_loop_tolerance(link, link.transforms.front(), judged.transform, extents))
     return LoopPoseJudgement::kImpliedWon;
   const bool tied = judged.ambiguity_margin < ambiguous_below(judged.free_space_used) && judged.hypotheses.size() >= 2 &&
                     judged.hypotheses[1].refined_score > 0 && implied_pose(judged.hypotheses[1].transform);
@@ -136,7 +136,7 @@ const char* to_string(LinkVerdict verdict) {
 }
 
 LoopSelectionResult select_loop_consistent(const std::vector<LinkCandidates>& links,
-                                           const std::vector<double>& scan_radius_m) {
+                                           const std::vector<ScanExtent>& extents) {
   const std::vector<Triangle> triangles = find_triangles(links);
   std::vector<std::vector<std::size_t>> through(links.size());  // triangles through each link
   for (std::size_t t = 0; t < triangles.size(); ++t)
@@ -149,7 +149,7 @@ LoopSelectionResult select_loop_consistent(const std::vector<LinkCandidates>& li
   // A triangle's residual and tolerance with the candidates `picks` on its three links.
   using Picks = std::array<int, 3>;
   auto loop_residual = [&](const Triangle& tri, const Picks& picks) {
-    return k4reg::loop_residual(links, tri, picks, scan_radius_m);
+    return k4reg::loop_residual(links, tri, picks, extents);
   };
   // Whether the closed loop vouches for its link `self` (see the header); links confirmed by other loops
   // count as certain.

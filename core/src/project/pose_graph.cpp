@@ -27,8 +27,9 @@ Eigen::Matrix4d perturbed(const Eigen::Matrix4d& pose, const Vector6d& delta) {
 Vector6d residual(const Eigen::Matrix4d& from, const Eigen::Matrix4d& to, const PoseGraphLink& link) {
   const Eigen::Matrix4d misfit = link_misfit(from, to, link.measured);
   Vector6d r;
-  r.head<3>() = link.lever_arm_m * rotation_log(misfit.topLeftCorner<3, 3>());
-  r.tail<3>() = misfit.topRightCorner<3, 1>();
+  const Eigen::Vector3d& centre = link.from_extent.centre_m;
+  r.head<3>() = link.from_extent.radius_m * rotation_log(misfit.topLeftCorner<3, 3>());
+  r.tail<3>() = misfit.topLeftCorner<3, 3>() * centre + misfit.topRightCorner<3, 1>() - centre;
   return r;
 }
 
@@ -56,8 +57,9 @@ PoseGraphResult optimize_pose_graph(const std::vector<Eigen::Matrix4d>& initial,
   const std::size_t n = initial.size();
   if (params.fixed >= n) fail(ErrorCode::kInvalidArgument, "pose graph: the fixed scan is out of range");
   for (const PoseGraphLink& link : links)
-    if (link.from >= n || link.to >= n || link.from == link.to || !(link.weight > 0) || !(link.lever_arm_m >= 0))
-      fail(ErrorCode::kInvalidArgument, "pose graph: a link has bad scan indices, weight or lever arm");
+    if (link.from >= n || link.to >= n || link.from == link.to || !(link.weight > 0) ||
+        !(link.from_extent.radius_m >= 0) || !link.from_extent.centre_m.allFinite())
+      fail(ErrorCode::kInvalidArgument, "pose graph: a link has bad scan indices, weight or extent");
 
   // Unknown block of each scan (the fixed one has none).
   std::vector<int> block(n, -1);
@@ -134,7 +136,7 @@ PoseGraphResult optimize_pose_graph(const std::vector<Eigen::Matrix4d>& initial,
   }
   for (const PoseGraphLink& link : links)
     out.residual_m.push_back(displacement_m(link_misfit(out.poses[link.from], out.poses[link.to], link.measured),
-                                            link.lever_arm_m));
+                                            link.from_extent));
   return out;
 }
 

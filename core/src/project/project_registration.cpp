@@ -24,14 +24,11 @@
 namespace k4reg {
 namespace {
 
-// A scan's radius about its frame's origin (the scanner, for terrestrial scans): how far a rotation error
-// moves its points. Robust to stray far returns: half the robust diameter, or the distance to it.
-double scan_radius_m(const PointCloud& cloud) {
-  const double half = 0.5 * robust_diameter(cloud.points);
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3f& p : cloud.points) centre += p.cast<double>();
-  centre = centre / static_cast<double>(cloud.points.size()) + cloud.origin_m;
-  return std::max(half, centre.norm() + half);
+// Where a scan's points lie, in its file's frame: their centroid and, as the radius a rotation error moves them
+// by, the robust diameter (the centroid lies within the 2nd..98th percentile box, so no corner of it is farther;
+// stray far returns do not count).
+ScanExtent scan_extent(const PointCloud& cloud) {
+  return {centroid(cloud.points) + cloud.origin_m, robust_diameter(cloud.points)};
 }
 
 // The pose of scan `scan` that a link to an already placed scan proposes.
@@ -46,7 +43,7 @@ Eigen::Matrix4d proposed_pose(const ProjectResult& r, const ProjectLink& link, s
 // supported proposal of all goes first (then more loops closed, better support, lower link index). A wrong
 // link that slipped through the loops is outvoted here rather than carried along a spanning tree. Scans
 // that never gain a majority stay unregistered.
-void place_scans(ProjectResult& r, const std::vector<double>& radius) {
+void place_scans(ProjectResult& r, const std::vector<ScanExtent>& extents) {
   for (ProjectScan& scan : r.scans) {
     scan.registered = scan.ambiguous = false;
     scan.pose = Eigen::Matrix4d::Identity();
@@ -68,7 +65,7 @@ void place_scans(ProjectResult& r, const std::vector<double>& radius) {
       for (const auto& [l, pose] : proposals) {
         std::size_t votes = 0;
         for (const auto& [m, other] : proposals)
-          votes += displacement_m(rigid_inverse(pose) * other, radius[x]) <=
+          votes += displacement_m(rigid_inverse(pose) * other, extents[x]) <=
                    kLoopToleranceFactor * std::hypot(link_tolerance_m(r.links[l]), link_tolerance_m(r.links[m]));
         if (2 * votes <= proposals.size()) continue;
         const Key key{votes, r.links[l].loops_closed, r.links[l].cloud_score, r.links.size() - l};
@@ -146,13 +143,14 @@ LinkCandidates link_from_outcome(const PairOutcome& outcome, const ScanPair& pai
 
 // The scans that no loop of the pairs registered so far confirms (a first loop selection, milliseconds).
 std::vector<std::size_t> unconfirmed_scans(std::size_t scans, const std::vector<ScanPair>& pairs,
-                                           const std::vector<PairOutcome>& outcomes, const std::vector<double>& radius) {
+                                           const std::vector<PairOutcome>& outcomes,
+                                           const std::vector<ScanExtent>& extents) {
   std::vector<LinkCandidates> found;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     ProjectLink scratch;
     found.push_back(link_from_outcome(outcomes[k], pairs[k], scratch));
   }
-  const LoopSelectionResult selection = select_loop_consistent(found, radius);
+  const LoopSelectionResult selection = select_loop_consistent(found, extents);
   std::vector<bool> confirmed(scans, false);
   for (std::size_t k = 0; k < pairs.size(); ++k)
     if (selection.links[k].verdict == LinkVerdict::kConfirmed) confirmed[pairs[k].first] = confirmed[pairs[k].second] = true;
@@ -206,8 +204,8 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
   // Each scan's voxels, keypoints and pyramids are computed once, in its first pair, and shared by the rest.
   const std::vector<PreparedScan> prepared(scans.begin(), scans.end());
 
-  std::vector<double> radius(scans.size());
-  for (std::size_t i = 0; i < scans.size(); ++i) radius[i] = scan_radius_m(scans[i]);
+  std::vector<ScanExtent> extents(scans.size());
+  for (std::size_t i = 0; i < scans.size(); ++i) extents[i] = scan_extent(scans[i]);
 
   // 1. Pairwise registration, keeping every distinct hypothesis as a candidate for the loops. Large projects
   //    register each scan's best partners only, by a cheap overlap estimate of every pair.
@@ -243,7 +241,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
   // A screened scan that no loop of its first pairs confirms gets its next best partners too, once: the loops
   // need them to check its links.
   if (r.pairs_used == PairSelection::kScreened) {
-    const std::vector<std::size_t> extend = unconfirmed_scans(scans.size(), pairs, outcomes, radius);
+    const std::vector<std::size_t> extend = unconfirmed_scans(scans.size(), pairs, outcomes, extents);
     const std::vector<ScanPair> more = more_partners(scans.size(), estimates, pairs, extend, params.partners);
     if (!more.empty()) {
       const std::size_t first_new = pairs.size();
@@ -257,7 +255,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
   // searched again from the other side; a well-supported result from there replaces theirs, the link's source
   // and target swapped.
   {
-    const std::vector<std::size_t> unconfirmed = unconfirmed_scans(scans.size(), pairs, outcomes, radius);
+    const std::vector<std::size_t> unconfirmed = unconfirmed_scans(scans.size(), pairs, outcomes, extents);
     auto doubtful = [&](std::size_t i) { return std::binary_search(unconfirmed.begin(), unconfirmed.end(), i); };
     std::vector<std::size_t> again;
     for (std::size_t k = 0; k < pairs.size(); ++k)
@@ -306,7 +304,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     RegistrationParams judge = pairwise;
     judge.overlap = link.overlap_used;  // at the project's scale, as the loops' poses are judged below
     const auto [s, t] = pairs[l];
-    const TwoSidedJudgement j = judge_from_both_sides(prepared[s], prepared[t], candidates[l], judge, radius, &budget);
+    const TwoSidedJudgement j = judge_from_both_sides(prepared[s], prepared[t], candidates[l], judge, extents, &budget);
     if (!j.judged) continue;
     link.reverse_judged = true;
     link.runner_up_preferred = j.runner_up_preferred;
@@ -321,8 +319,8 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
   //    imply for a link is judged on the link's own clouds (the pair's 4PCS may have missed the truth), and the
   //    loops choose again.
   start = SteadyClock::now();
-  const LoopSelectionResult first = select_loop_consistent(candidates, radius);
-  const std::vector<std::vector<Eigen::Matrix4d>> implied = poses_implied_by_open_loops(candidates, first, radius);
+  const LoopSelectionResult first = select_loop_consistent(candidates, extents);
+  const std::vector<std::vector<Eigen::Matrix4d>> implied = poses_implied_by_open_loops(candidates, first, extents);
   add_timing(r.timings, "selection", seconds_since(start));
   start = SteadyClock::now();
   for (std::size_t l = 0; l < r.links.size(); ++l) {
@@ -349,14 +347,14 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
     // close that the clouds cannot tell them apart: then the judged result, flagged ambiguous, replaces it and
     // the loops choose between the two.
     if (!outcome.result) continue;
-    const LoopPoseJudgement judgement = judge_implied_poses(candidates[l], implied[l], *outcome.result, radius);
+    const LoopPoseJudgement judgement = judge_implied_poses(candidates[l], implied[l], *outcome.result, extents);
     if (judgement == LoopPoseJudgement::kWinnerStands) continue;
     candidates[l] = link_from_outcome(outcome, pairs[l], r.links[l]);
     r.links[l].loop_pose_won = judgement == LoopPoseJudgement::kImpliedWon;
   }
   add_timing(r.timings, "loop_poses", seconds_since(start));
   start = SteadyClock::now();
-  const LoopSelectionResult selection = select_loop_consistent(candidates, radius);
+  const LoopSelectionResult selection = select_loop_consistent(candidates, extents);
   r.loops_checked = selection.loops_checked;
   r.loops_inconsistent = selection.loops_inconsistent;
   for (std::size_t l = 0; l < r.links.size(); ++l) {
@@ -413,7 +411,7 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
   if (progress) progress("refinement", 0.0);
   for (;;) {
     check(&budget);
-    place_scans(r, radius);
+    place_scans(r, extents);
     std::vector<std::size_t> used;  // accepted links between registered scans, in agreement with the placement
     std::vector<PoseGraphLink> graph;
     std::vector<double> tolerances;
@@ -422,14 +420,14 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
       if (!link.accepted) continue;
       if (!r.scans[link.source].registered || !r.scans[link.target].registered) continue;
       const double misfit = displacement_m(link_misfit(r.scans[link.source].pose, r.scans[link.target].pose, link.transform),
-                                           radius[link.source]);
+                                           extents[link.source]);
       const double tolerance = kLoopToleranceFactor * link_tolerance_m(link);
       if (misfit > tolerance) {
         reject(r, l, fmt::format("disagrees with the poses most links support by {:.3g} m (tolerance {:.3g} m)", misfit, tolerance));
         continue;
       }
       used.push_back(l);
-      graph.push_back({link.source, link.target, link.transform, radius[link.source], 1.0});
+      graph.push_back({link.source, link.target, link.transform, extents[link.source], 1.0});
       tolerances.push_back(link_tolerance_m(link));
     }
     // Each link weighs by its precision: its refinement's residual, against the median link's. A pose its loops
@@ -444,10 +442,10 @@ ProjectResult register_project(const std::vector<PointCloud>& scans, const Proje
       }
     }
     // Scans that a confident pairwise result contradicts leave the project (scan_conflicts.h).
-    refuse_conflicted_scans(r, radius);
+    refuse_conflicted_scans(r, extents);
     refuse_minority_placements(r);
     // Scans held too weakly to tell from a twin placement leave the project, with their links (twin_motion.h).
-    const std::vector<TwinHold> holds = holds_against_twins(r, candidates, used, radius, 1.0);
+    const std::vector<TwinHold> holds = holds_against_twins(r, candidates, used, extents, 1.0);
     for (std::size_t i = 0; i < r.scans.size(); ++i) {
       ProjectScan& scan = r.scans[i];
       scan.strength = scan.registered ? holds[i].strength : 0.0;

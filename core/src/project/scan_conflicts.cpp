@@ -8,7 +8,7 @@
 
 namespace k4reg {
 
-void refuse_conflicted_scans(ProjectResult& r, const std::vector<double>& scan_radius_m) {
+void refuse_conflicted_scans(ProjectResult& r, const std::vector<ScanExtent>& extents) {
   std::vector<std::size_t> holding(r.scans.size(), 0), contradicting(r.scans.size(), 0);
   std::vector<std::string> reasons(r.scans.size());
   for (const ProjectLink& link : r.links)
@@ -18,7 +18,7 @@ void refuse_conflicted_scans(ProjectResult& r, const std::vector<double>& scan_r
     if (link.accepted || link.verdict == "failed" || link.ambiguous || !link.well_supported) continue;
     if (!r.scans[link.source].registered || !r.scans[link.target].registered) continue;
     const double misfit = displacement_m(link_misfit(r.scans[link.source].pose, r.scans[link.target].pose, link.transform),
-                                         scan_radius_m.at(link.source));
+                                         extents.at(link.source));
     if (misfit <= kLoopToleranceFactor * link_tolerance_m(link)) continue;
     for (std::size_t scan : {link.source, link.target}) {
       ++contradicting[scan];

@@ -37,10 +37,10 @@ Eigen::Matrix4d moved_link(const ProjectResult& p, const ProjectLink& link, cons
 
 // The best score among the link's other candidates that stand for transform t (within its loop tolerance); nothing
 // where none does.
-std::optional<double> score_standing_for(const LinkCandidates& c, const Eigen::Matrix4d& t, double radius_m) {
+std::optional<double> score_standing_for(const LinkCandidates& c, const Eigen::Matrix4d& t, const ScanExtent& extent) {
   std::optional<double> best;
   for (std::size_t k = 1; k < std::min(c.transforms.size(), c.scores.size()); ++k)
-    if (displacement_m(rigid_inverse(c.transforms[k]) * t, radius_m) <= kLoopToleranceFactor * c.tolerance_m)
+    if (displacement_m(rigid_inverse(c.transforms[k]) * t, extent) <= kLoopToleranceFactor * c.tolerance_m)
       best = std::max(best.value_or(c.scores[k]), c.scores[k]);
   return best;
 }
@@ -48,12 +48,12 @@ std::optional<double> score_standing_for(const LinkCandidates& c, const Eigen::M
 // The link's source-side margin over its candidate for `motion` (whichever end moves: the smaller), never less than
 // over its best runner-up, which it keeps where it has no candidate for the motion.
 double forward_margin_against(const ProjectResult& p, const ProjectLink& link, const LinkCandidates& c,
-                              const Eigen::Matrix4d& motion, const std::vector<double>& radius_m) {
+                              const Eigen::Matrix4d& motion, const std::vector<ScanExtent>& extents) {
   const double fallback = forward_margin(link, c);
   double smallest = std::numeric_limits<double>::infinity();
   for (const bool source_moves : {true, false}) {
     const std::optional<double> score =
-        score_standing_for(c, moved_link(p, link, motion, source_moves), radius_m.at(link.source));
+        score_standing_for(c, moved_link(p, link, motion, source_moves), extents.at(link.source));
     smallest = std::min(smallest, score ? std::max(score_margin(c.scores[0], *score, c.free_space_used), fallback) : fallback);
   }
   return smallest;
@@ -66,7 +66,7 @@ double link_weight(const ProjectLink& link, const LinkCandidates& candidates) {
 }
 
 std::vector<TwinHold> holds_against_twins(const ProjectResult& project, const std::vector<LinkCandidates>& candidates,
-                                          const std::vector<std::size_t>& used, const std::vector<double>& radius_m,
+                                          const std::vector<std::size_t>& used, const std::vector<ScanExtent>& extents,
                                           double cap) {
   const std::size_t n = project.scans.size();
   auto weighted = [&](auto weight_of) {
@@ -83,7 +83,7 @@ std::vector<TwinHold> holds_against_twins(const ProjectResult& project, const st
     return scan_holds(n, weighted([&](std::size_t l) {
                         const ProjectLink& link = project.links[l];
                         return weight_with(link,
-                                           forward_margin_against(project, link, candidates[l], motion, radius_m));
+                                           forward_margin_against(project, link, candidates[l], motion, extents));
                       }),
                       project.reference, cap);
   };
@@ -110,7 +110,7 @@ std::vector<TwinHold> holds_against_twins(const ProjectResult& project, const st
       const bool offered_by_all = std::all_of(across.begin(), across.end(), [&](std::size_t l) {
         const ProjectLink& link = project.links[l];
         return score_standing_for(candidates[l], moved_link(project, link, motion, moves(link.source)),
-                                  radius_m.at(link.source))
+                                  extents.at(link.source))
             .has_value();
       });
       if (!offered_by_all) continue;

@@ -11,7 +11,7 @@
 namespace k4reg {
 
 TwoSidedJudgement judge_from_both_sides(const PreparedScan& source, const PreparedScan& target, LinkCandidates& link,
-                                        const RegistrationParams& params, const std::vector<double>& scan_radius_m,
+                                        const RegistrationParams& params, const std::vector<ScanExtent>& extents,
                                         const CancellationToken* cancel) {
   TwoSidedJudgement out;
   if (link.transforms.size() < 2 || link.scores.size() < 2) return out;
@@ -29,9 +29,9 @@ TwoSidedJudgement judge_from_both_sides(const PreparedScan& source, const Prepar
   // refinement slid elsewhere, or it was not among the poses refined) says nothing: scored 0, it gave a corridor's
   // half turn a reverse margin of 1 over a runner-up that was not the truth either. So the sides are compared only
   // where the winner and a rival are both refined there.
-  const double target_radius_m = scan_radius_m.at(link.target);
+  const ScanExtent& target_extent = extents.at(link.target);
   auto stands_for = [&](const Hypothesis& h, const Eigen::Matrix4d& pose) {
-    return displacement_m(rigid_inverse(h.transform) * pose, target_radius_m) <= kLoopToleranceFactor * link.tolerance_m;
+    return displacement_m(rigid_inverse(h.transform) * pose, target_extent) <= kLoopToleranceFactor * link.tolerance_m;
   };
   std::optional<double> winner, rival;
   bool rival_is_runner_up = false;

@@ -14,10 +14,17 @@ Eigen::Matrix3d rotation_exp(const Eigen::Vector3d& w);
 // Axis-angle vector of a rotation matrix (angle in [0, pi]).
 Eigen::Vector3d rotation_log(const Eigen::Matrix3d& r);
 
-// How far a transform that should be the identity moves the points of a scan of radius lever_arm_m about
-// the frame's origin, in metres: sqrt(|t|^2 + (lever_arm_m * angle)^2). One number for rotation and
-// translation, in the units a user judges a registration by.
-double displacement_m(const Eigen::Matrix4d& t, double lever_arm_m);
+// Where a scan's points lie, in its own frame: their centre and their radius about it.
+struct ScanExtent {
+  Eigen::Vector3d centre_m = Eigen::Vector3d::Zero();
+  double radius_m = 0.0;
+};
+
+// How far a transform that should be the identity moves the points of a scan, in metres:
+// sqrt(|T c - c|^2 + (radius * angle)^2), c the scan's centre. One number for rotation and translation, in the
+// units a user judges a registration by; measured at the scan, so it does not depend on where its file puts its
+// origin (about an origin 40 m away, a twentieth of a degree would count as centimetres).
+double displacement_m(const Eigen::Matrix4d& t, const ScanExtent& scan);
 
 // How far apart two poses put the point at_m (in the posed scan's own frame).
 double shift_at_m(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b, const Eigen::Vector3d& at_m);

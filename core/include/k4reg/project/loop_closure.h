@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "k4reg/geometry/rigid_motion.h"
 #include "k4reg/registration/registration.h"
 
 namespace k4reg {
@@ -68,10 +69,10 @@ struct LoopSelectionResult {
 // The loop residual tolerance of a triangle: three times the links' expected errors added in quadrature.
 constexpr double kLoopToleranceFactor = 3.0;
 
-// scan_radius_m: per scan, its radius about its frame's origin, which weighs a loop's rotation residual
-// (displacement_m in rigid_motion.h) where the loop starts.
+// extents: per scan, where its points lie (centre and radius, its file's frame), at which a loop's residual is
+// measured where the loop starts (displacement_m in rigid_motion.h).
 LoopSelectionResult select_loop_consistent(const std::vector<LinkCandidates>& links,
-                                           const std::vector<double>& scan_radius_m);
+                                           const std::vector<ScanExtent>& extents);
 
 // Per link, the poses (source -> target) that its open triangles imply: where a triangle does not close with
 // the chosen candidates (a rejected link's pairwise winner standing in for it), the other two links' choices
@@ -82,19 +83,19 @@ LoopSelectionResult select_loop_consistent(const std::vector<LinkCandidates>& li
 // Poses within a link's tolerance of one of its candidates, or of one already implied, are left out.
 std::vector<std::vector<Eigen::Matrix4d>> poses_implied_by_open_loops(const std::vector<LinkCandidates>& links,
                                                                      const LoopSelectionResult& selection,
-                                                                     const std::vector<double>& scan_radius_m);
+                                                                     const std::vector<ScanExtent>& extents);
 
 // Whether two poses of a link lie within three times its expected error of each other (displacement where its
 // source scan is).
 bool within_loop_tolerance(const LinkCandidates& link, const Eigen::Matrix4d& a, const Eigen::Matrix4d& b,
-                           const std::vector<double>& scan_radius_m);
+                           const std::vector<ScanExtent>& extents);
 
 // What a pair's own clouds said of the poses its loops implied, from judge_poses' result on its winner and
 // them: the winner stands, an implied pose won, or the clouds cannot tell an implied pose (second, within the
 // ambiguity margin) from the winner, so the pair's own margin came from its 4PCS missing that pose.
 enum class LoopPoseJudgement { kWinnerStands, kImpliedWon, kTied };
 LoopPoseJudgement judge_implied_poses(const LinkCandidates& link, const std::vector<Eigen::Matrix4d>& implied,
-                                      const RegistrationResult& judged, const std::vector<double>& scan_radius_m);
+                                      const RegistrationResult& judged, const std::vector<ScanExtent>& extents);
 
 const char* to_string(LinkVerdict verdict);
 

@@ -2,8 +2,9 @@
 // registration, behind this small interface. Levenberg-Marquardt on SE(3) with Eigen's sparse LDLT (Eigen
 // only, so builds stay licence-clean: Debian's Ceres links GPL-2+ parts of SuiteSparse) and a Huber kernel,
 // so one link that survived the loop checks but disagrees with the rest bends the graph little.
-// Each link residual is the 6-vector [lever_arm_m * rotation; translation] of the transform that should be
-// the identity, so rotation and translation both count in metres of scan displacement.
+// Each link residual is the 6-vector [radius * rotation; displacement of the centre] of the transform that should be
+// the identity (the `from` scan's extent), so rotation and translation both count in metres of scan displacement,
+// measured where the scan is rather than at its file's origin.
 // Cost: per iteration O(links) residuals and a sparse factorisation of 6(N-1) unknowns (N = scans):
 // milliseconds for hundreds of scans, next to seconds per pairwise registration.
 #pragma once
@@ -12,12 +13,14 @@
 #include <cstddef>
 #include <vector>
 
+#include "k4reg/geometry/rigid_motion.h"
+
 namespace k4reg {
 
 struct PoseGraphLink {
   std::size_t from = 0, to = 0;          // scan indices
   Eigen::Matrix4d measured = Eigen::Matrix4d::Identity();  // p_to = measured * p_from (scan frames)
-  double lever_arm_m = 1.0;  // radius of the `from` scan about its frame's origin: weights rotation
+  ScanExtent from_extent{Eigen::Vector3d::Zero(), 1.0};  // where the `from` scan's points lie (its frame)
   double weight = 1.0;       // relative confidence (> 0)
 };
 

@@ -10,13 +10,14 @@
 
 #include <vector>
 
+#include "k4reg/geometry/rigid_motion.h"
 #include "k4reg/project/project_registration.h"
 
 namespace k4reg {
 
-// Clears `registered` and sets `reason` on every such scan but the reference. scan_radius_m: per scan, its
-// radius about its frame's origin (weighs a rotation misfit, as in the loops).
-void refuse_conflicted_scans(ProjectResult& result, const std::vector<double>& scan_radius_m);
+// Clears `registered` and sets `reason` on every such scan but the reference. extents: per scan, where
+// its points lie (misfits are measured there, as in the loops).
+void refuse_conflicted_scans(ProjectResult& result, const std::vector<ScanExtent>& extents);
 
 // Scans placed on a minority of their own evidence: where most of a registered scan's accepted links lead to
 // scans the project refused, the few that placed it may be the wrong side of a conflict the others would have

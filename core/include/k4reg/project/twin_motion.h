@@ -39,9 +39,9 @@ struct TwinHold {
 double link_weight(const ProjectLink& link, const LinkCandidates& candidates);
 
 // Per scan, from the placed poses in `project` (reference: project.reference) and the links in `used` (indices into
-// project.links and candidates, each with its chosen `candidate`). radius_m: per scan, as in the loops.
+// project.links and candidates, each with its chosen `candidate`). extents: per scan, as in the loops.
 std::vector<TwinHold> holds_against_twins(const ProjectResult& project, const std::vector<LinkCandidates>& candidates,
-                                          const std::vector<std::size_t>& used, const std::vector<double>& radius_m,
+                                          const std::vector<std::size_t>& used, const std::vector<ScanExtent>& extents,
                                           double cap);
 
 }  // namespace k4reg

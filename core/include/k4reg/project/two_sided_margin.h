@@ -34,7 +34,7 @@ struct TwoSidedJudgement {
 // Reorders the two where their sum is negative and sets link.margin and link.ambiguous to the two-sided verdict.
 // Rethrows cancellation; another failure leaves the link as it was (judged = false).
 TwoSidedJudgement judge_from_both_sides(const PreparedScan& source, const PreparedScan& target, LinkCandidates& link,
-                                        const RegistrationParams& params, const std::vector<double>& scan_radius_m,
+                                        const RegistrationParams& params, const std::vector<ScanExtent>& extents,
                                         const CancellationToken* cancel = nullptr);
 
 }  // namespace k4reg
