@@ -11,6 +11,9 @@
 namespace k4reg {
 namespace {
 
+// The hall's two stations about their scanners, 20 m across.
+const std::vector<ScanExtent> kHallExtents(2, ScanExtent{Eigen::Vector3d::Zero(), 20.0});
+
 // Hall layout 4, stations 0 -> 1: from station 0's side the half turn explains the source as fully as the truth
 // (both 1.00), since the partition station 0 saw lands where station 1 could not look; from station 1's side the
 // partition it saw contradicts the half turn.
@@ -40,7 +43,7 @@ TEST_F(HallOppositeCorners, TargetsSideTurnsATieIntoTheTruthWhicheverCandidateCa
   params.overlap = 0.4;
   params.seed = 1;
   const RegistrationResult pair = register_clouds(source, target, params);
-  const std::vector<ScanExtent> radius(2, ScanExtent{Eigen::Vector3d::Zero(), 20.0});
+  const std::vector<ScanExtent>& radius = kHallExtents;
   auto error_m = [&](const Eigen::Matrix4d& t) { return displacement_m(rigid_inverse(truth()) * t, radius[0]); };
   const Hypothesis *true_pose = nullptr, *half_turn = nullptr;
   for (const Hypothesis& h : pair.hypotheses) {
@@ -81,7 +84,7 @@ TEST_F(HallOppositeCorners, ARunnerUpTheTargetsSideDoesNotRefineIsNoEvidence) {
   RegistrationParams params;
   params.min_scale_m = 0.1;
   params.overlap = 0.4;
-  const TwoSidedJudgement j = judge_from_both_sides(source, target, link, params, {20.0, 20.0});
+  const TwoSidedJudgement j = judge_from_both_sides(source, target, link, params, kHallExtents);
   EXPECT_TRUE(j.judged);
   EXPECT_FALSE(j.runner_up_preferred);
   EXPECT_GT(j.reverse_margin, 0.0);
@@ -96,7 +99,7 @@ TEST_F(HallOppositeCorners, ALinkWithOneCandidateIsNotJudged) {
   RegistrationParams params;
   params.min_scale_m = 0.1;
   params.overlap = 0.4;
-  EXPECT_FALSE(judge_from_both_sides(source, target, link, params, {20.0, 20.0}).judged);
+  EXPECT_FALSE(judge_from_both_sides(source, target, link, params, kHallExtents).judged);
   EXPECT_DOUBLE_EQ(link.margin, 1.0);
 }
 
