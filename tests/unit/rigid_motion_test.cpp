@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <vector>
 
 #include "k4reg/geometry/rigid_motion.h"
@@ -31,6 +32,20 @@ TEST(RigidMotion, PosesAreComparedAtTheScanNotAtTheOrigin) {
     EXPECT_TRUE(distinct_transforms(a, shifted, centre, 2.0, 0.01));  // beyond the shift bar
     EXPECT_NEAR(shift_at_m(a, shifted, centre), 0.02, 1e-12);
   }
+}
+
+TEST(RigidMotion, DisplacementIsMeasuredWhereTheScanIs) {
+  // A scan 0.2 m across: a 0.1-degree turn about its centre moves its points by 0.35 mm wherever it lies.
+  for (const Eigen::Vector3d centre : {Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(29.0, -29.0, 12.0)}) {
+    const ScanExtent scan{centre, 0.2};
+    EXPECT_NEAR(displacement_m(turn_about(centre, 0.1), scan), 0.2 * 0.1 * M_PI / 180.0, 1e-9) << centre.transpose();
+    Eigen::Matrix4d shifted = Eigen::Matrix4d::Identity();
+    shifted.topRightCorner<3, 1>() = Eigen::Vector3d(0.003, 0.004, 0.0);
+    EXPECT_NEAR(displacement_m(shifted, scan), 0.005, 1e-12);
+  }
+  // The same turn about the file's origin moves a scan 43 m away by 7.5 cm.
+  EXPECT_NEAR(displacement_m(turn_about(Eigen::Vector3d::Zero(), 0.1), {Eigen::Vector3d(29.0, -29.0, 12.0), 0.2}),
+              std::hypot(std::hypot(29.0, 29.0) * 0.1 * M_PI / 180.0, 0.2 * 0.1 * M_PI / 180.0), 1e-6);
 }
 
 TEST(RigidMotion, CentroidIsTheMeanInDouble) {
