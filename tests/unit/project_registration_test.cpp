@@ -124,7 +124,9 @@ TEST(ProjectRegistration, ScansFarFromTheirFilesOriginsRegisterAsNearThem) {
     EXPECT_LT(rms_error_m(scans[k], r.scans[k].pose, bunny.truth[used[k]]), 0.001) << bunny.files[used[k]];
   }
   for (const ProjectLink& l : r.links)
-    if (l.accepted) EXPECT_LT(l.residual_m, 0.002) << l.source << "->" << l.target;
+    if (l.accepted) {
+      EXPECT_LT(l.residual_m, 0.002) << l.source << "->" << l.target;
+    }
 }
 
 TEST(ProjectRegistration, ScreenedPairsRegisterEachScanWithItsBestPartners) {

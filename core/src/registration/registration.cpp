@@ -34,15 +34,17 @@
 namespace k4reg {
 namespace {
 
-class StageTimer {
+// Runs the registration's named stages, each timed into the result and reported to the progress callback.
+class StageRunner {
  public:
-  StageTimer(RegistrationResult& result, const ProgressCallback& progress) : result_(result), progress_(progress) {}
+  StageRunner(RegistrationResult& result, const ProgressCallback& progress) : result_(result), progress_(progress) {}
   template <typename F>
   auto run(const std::string& stage, F&& f) {
     if (progress_) progress_(stage, 0.0);
-    const auto start = SteadyClock::now();
-    auto value = f();
-    add_timing(result_.timings, stage, seconds_since(start));
+    auto value = [&] {
+      const StageTimer timer(result_.timings, stage);
+      return f();
+    }();
     if (progress_) progress_(stage, 1.0);
     return value;
   }
@@ -225,7 +227,7 @@ struct Verdict {
 
 Verdict judge_contenders(const SymmetryGuardResult& guarded, const IcpPyramid& source, const IcpPyramid& target,
                          const IcpParams& final_params, const PoseScorer& scorer, const SurfaceBar& bar, bool icp,
-                         double sigma, StageTimer& timer, const CancellationToken* cancel) {
+                         double sigma, StageRunner& stages, const CancellationToken* cancel) {
   Verdict verdict;
   verdict.hypotheses = guarded.hypotheses;
   verdict.margin = guarded.ambiguity_margin;
@@ -243,7 +245,7 @@ Verdict judge_contenders(const SymmetryGuardResult& guarded, const IcpPyramid& s
   IcpParams contender_params = final_params;
   contender_params.converged_step_voxels = kSettledStepVoxels;
   std::vector<IcpResult> refined(contenders);
-  timer.run("icp", [&] {
+  stages.run("icp", [&] {
     tbb::parallel_for(std::size_t{0}, contenders, [&](std::size_t i) {
       refined[i] = refine_icp(contender_source, target, hypotheses[i].transform, contender_params, cancel);
     });
@@ -252,7 +254,7 @@ Verdict judge_contenders(const SymmetryGuardResult& guarded, const IcpPyramid& s
   // Per contender: the share of the source the target explains once refined, and how much of what comes
   // near the target surface lies on it. Contenders that refined into an earlier one's pose drop out.
   std::vector<std::size_t> kept;
-  timer.run("verdict", [&] {
+  stages.run("verdict", [&] {
     tbb::parallel_for(std::size_t{0}, contenders, [&](std::size_t i) {
       Hypothesis& h = hypotheses[i];
       if (icp) h.transform = refined[i].transform;
@@ -323,12 +325,12 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   result.source_points = source.size();
   result.target_points = target.size();
   result.min_scale_m_used = sigma;
-  StageTimer timer(result, progress);
+  StageRunner stages(result, progress);
 
   // 1. Voxel grid at the minimum scale (paper Sec. 2.1).
   // Named references rather than structured bindings: lambdas below use them, and clang < 16 cannot capture
   // a structured binding.
-  const auto voxelised = timer.run("voxel_grid", [&] {
+  const auto voxelised = stages.run("voxel_grid", [&] {
     return std::make_pair(&source_scan.voxels(sigma, cancel), &target_scan.voxels(sigma, cancel));
   });
   const VoxelizedCloud &source_voxels = *voxelised.first, &target_voxels = *voxelised.second;
@@ -346,7 +348,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   std::optional<Pyramids> pyramids;
   auto icp_pyramids = [&]() -> const Pyramids& {
     if (!pyramids)
-      pyramids.emplace(timer.run("icp_setup", [&] {
+      pyramids.emplace(stages.run("icp_setup", [&] {
         return Pyramids(source_scan.pyramid(sigma, icp_params, false, cancel),
                         target_scan.pyramid(sigma, icp_params, true, cancel));
       }));
@@ -356,14 +358,14 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   // about 2 sigma of each other (measured on the simulated lab and the bunny); plain 4PCS works on a
   // coarser grid, whose spacing it is.
   const bool plain = params.method == CoarseMethod::kPlain4pcs;
-  const double delta = !plain ? 2.0 * sigma : timer.run("plain_grid", [&] {
+  const double delta = !plain ? 2.0 * sigma : stages.run("plain_grid", [&] {
     return params.plain_voxel_m > 0 ? params.plain_voxel_m : spacing_for_count(source_voxels.cloud, 4 * sigma, 2000);
   });
   // Free space (free_space.h), seen from the scanners or along the cameras (free_space_from). Raw points fill
   // every cell.
   const double margin_m = 3.0 * delta;
   ScanViews views;
-  const FreeSpaceFrom from = timer.run("scanner_position", [&] {
+  const FreeSpaceFrom from = stages.run("scanner_position", [&] {
     return free_space_from(params.free_space, source_scan, target_scan, sigma, cancel);
   });
   if (from == FreeSpaceFrom::kScanners)
@@ -385,7 +387,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
       if (sets.signal == (plain ? "voxels" : surface_signal_name(signal, intensity))) return sets;
     PointSets& sets = point_sets.emplace_back();
     if (!plain) {
-      timer.run("keypoints", [&] {
+      stages.run("keypoints", [&] {
         const DogParams dog{sigma, params.octaves, params.scales_per_octave, params.min_contrast};
         const ScanKeypoints& from = source_scan.keypoints(sigma, signal, intensity, dog, cancel);
         const ScanKeypoints& to = target_scan.keypoints(sigma, signal, intensity, dog, cancel);
@@ -395,7 +397,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
         return 0;
       });
     } else {
-      timer.run("plain_grid", [&] {
+      stages.run("plain_grid", [&] {
         sets.source = voxel_grid(source_voxels.cloud, delta, cancel).cloud.points;
         sets.target = voxel_grid(target_voxels.cloud, delta, cancel).cloud.points;
         return 0;
@@ -422,7 +424,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
     out.overlap = overlap;
 
     // 3. 4PCS on the two point sets (paper Sec. 2.2).
-    const FourPcsResult matched = timer.run("matching", [&] {
+    const FourPcsResult matched = stages.run("matching", [&] {
       FourPcsParams four{delta, overlap, params.max_bases, params.hypotheses_kept, seed};
       four.levelled = params.levelled;
       if (!plain) four.source_labels = &sets.source_labels, four.target_labels = &sets.target_labels;
@@ -433,7 +435,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
     // 4. Symmetry guard: settle each distinct hypothesis with a short coarse ICP and re-score it on the
     //    voxelised clouds, where the furniture that breaks a room's symmetry is visible.
     const auto& icp = icp_pyramids();
-    out.guarded = timer.run("symmetry_guard", [&] {
+    out.guarded = stages.run("symmetry_guard", [&] {
       return rank_hypotheses(icp.first, icp.second, matched.hypotheses, overlap, seen,
                              params.levelled, cancel);
     });
@@ -461,7 +463,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
     for (std::size_t i = 0; i < given_poses.size(); ++i)
       hypotheses[i].transform = to_local_frames(given_poses[i], source.origin_m, target.origin_m);
     const auto& icp = icp_pyramids();
-    judged.guarded = timer.run("symmetry_guard", [&] {
+    judged.guarded = stages.run("symmetry_guard", [&] {
       return rank_hypotheses(icp.first, icp.second, std::move(hypotheses), judged.overlap, seen,
                              params.levelled, cancel);
     });
@@ -502,7 +504,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   const PoseScorer scorer(icp.first, icp.second, seen, result.overlap_used);
   const SurfaceBar bar(target_scan, sigma, cancel);
   auto judge = [&](const SymmetryGuardResult& guarded) {
-    return judge_contenders(guarded, icp.first, icp.second, final_params, scorer, bar, params.icp, sigma, timer, cancel);
+    return judge_contenders(guarded, icp.first, icp.second, final_params, scorer, bar, params.icp, sigma, stages, cancel);
   };
   Verdict verdict = judge(chosen->guarded);
   // Where the verdict cannot decide and the hypotheses show the scene repeating under a shift (a corridor's
@@ -511,7 +513,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   if (params.icp && (verdict.margin < kAmbiguousMargin || verdict.disputed_by > 0.0) &&
       repeats_under_a_shift(verdict.hypotheses, centroid(icp.first.stages.front().points),
                             2.0 * icp.second.stages.front().voxel_m)) {
-    const SymmetryGuardResult wider = timer.run("symmetry_guard", [&] {
+    const SymmetryGuardResult wider = stages.run("symmetry_guard", [&] {
       return rank_hypotheses(icp.first, icp.second, verdict.hypotheses, result.overlap_used, seen,
                              params.levelled, cancel, true);
     });
@@ -523,7 +525,7 @@ ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedSc
   // The winner polished on every source point at the finest stage, and below it where that is cheap
   // (fine_polish.h); with --no-icp, its quality figures only.
   const Hypothesis& best = result.hypotheses.front();
-  const IcpResult final_icp = timer.run("polish", [&] {
+  const IcpResult final_icp = stages.run("polish", [&] {
     return polish_winner(source_scan, target_scan, icp.first, icp.second, sigma, best.transform, final_params, cancel);
   });
   const Eigen::Matrix4d local = params.icp ? final_icp.transform : best.transform;
@@ -610,11 +612,6 @@ class ScaleLadder {
   double start_m_;
 };
 
-// Stage timings of two attempts added up, stage by stage.
-void add_timings(std::vector<StageTiming>& total, const std::vector<StageTiming>& more) {
-  for (const StageTiming& t : more) add_timing(total, t.stage, t.seconds);
-}
-
 // Where a scale finds no well-supported pose: the search from the other side. 4PCS draws its bases in the
 // source, and one scan's keypoints may be ones its partner does not repeat while the partner's are found in it
 // (the bunny at 3 mm: bun270 -> bun000 ends turned by 161 deg in two seeds of three, bun000 -> bun270 right in
@@ -687,14 +684,6 @@ RegistrationResult run(const PreparedScan& source, const PreparedScan& target, c
 }
 
 }  // namespace
-
-void add_timing(std::vector<StageTiming>& timings, const std::string& stage, double seconds) {
-  auto same = std::find_if(timings.begin(), timings.end(), [&](const StageTiming& t) { return t.stage == stage; });
-  if (same != timings.end())
-    same->seconds += seconds;
-  else
-    timings.push_back({stage, seconds});
-}
 
 double starting_scale_m(const PreparedScan& source, const PreparedScan& target, double min_scale_m) {
   if (min_scale_m > 0.0) return min_scale_m;

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "k4reg/geometry/rigid_motion.h"
-#include "k4reg/project/project_registration.h"
+#include "k4reg/project/project_types.h"
 
 namespace k4reg {
 

@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "k4reg/project/loop_closure.h"
-#include "k4reg/project/project_registration.h"
+#include "k4reg/project/project_types.h"
 
 namespace k4reg {
 

@@ -14,6 +14,7 @@
 #include "k4reg/util/cancellation.h"
 #include "k4reg/geometry/point_cloud.h"
 #include "k4reg/registration/scanner_position.h"
+#include "k4reg/util/stage_timing.h"
 
 namespace k4reg {
 
@@ -104,14 +105,6 @@ constexpr double kMinSurfaceAgreement = 0.75;
 // Below this margin between the best pose and the runner-up, a result judged with free space is flagged ambiguous
 // (on geometry alone it needs more: ambiguity_margin.h).
 constexpr double kAmbiguousMargin = 0.05;
-
-struct StageTiming {
-  std::string stage;
-  double seconds = 0.0;
-};
-
-// Adds seconds to the stage's entry (appended where the stage is new): a stage run more than once reports its total.
-void add_timing(std::vector<StageTiming>& timings, const std::string& stage, double seconds);
 
 struct RegistrationResult {
   Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();  // source -> target, in the files' frames

@@ -1,0 +1,213 @@
+#include "k4reg/project/placement.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <tuple>
+
+#include "k4reg/geometry/rigid_motion.h"
+#include "k4reg/project/pose_graph.h"
+#include "k4reg/project/scan_conflicts.h"
+#include "k4reg/project/twin_motion.h"
+#include "k4reg/registration/translation_constraint.h"
+#include "k4reg/util/median.h"
+#include "k4reg/util/stage_timing.h"
+
+namespace k4reg {
+namespace {
+
+// The pose of scan `scan` that a link to an already placed scan proposes.
+Eigen::Matrix4d proposed_pose(const ProjectResult& r, const ProjectLink& link, std::size_t scan) {
+  return scan == link.source ? r.scans[link.target].pose * link.transform
+                             : r.scans[link.source].pose * rigid_inverse(link.transform);
+}
+
+// Initial poses by consensus, one scan at a time from the reference: every accepted link from an unplaced
+// scan to a placed one proposes a pose, and each proposal counts the proposals that agree with it (within
+// the two links' tolerances). A scan is placed only where a strict majority of its links agree; the best
+// supported proposal of all goes first (then more loops closed, better support, lower link index). A wrong
+// link that slipped through the loops is outvoted here rather than carried along a spanning tree. Scans
+// that never gain a majority stay unregistered.
+void place_scans(ProjectResult& r, const std::vector<ScanExtent>& extents) {
+  for (ProjectScan& scan : r.scans) {
+    scan.registered = scan.ambiguous = false;
+    scan.pose = Eigen::Matrix4d::Identity();
+    scan.reason.clear();
+    scan.candidate_poses.clear();
+  }
+  r.scans[r.reference].registered = true;
+  using Key = std::tuple<std::size_t, int, double, std::size_t>;  // votes, loops closed, score, -link
+  for (;;) {
+    std::optional<std::pair<Key, std::pair<std::size_t, Eigen::Matrix4d>>> best;  // key, (scan, pose)
+    for (std::size_t x = 0; x < r.scans.size(); ++x) {
+      if (r.scans[x].registered) continue;
+      std::vector<std::pair<std::size_t, Eigen::Matrix4d>> proposals;  // link, pose
+      for (std::size_t l : r.scans[x].links) {
+        const ProjectLink& link = r.links[l];
+        if (r.scans[link.source == x ? link.target : link.source].registered)
+          proposals.emplace_back(l, proposed_pose(r, link, x));
+      }
+      for (const auto& [l, pose] : proposals) {
+        std::size_t votes = 0;
+        for (const auto& [m, other] : proposals)
+          votes += displacement_m(rigid_inverse(pose) * other, extents[x]) <=
+                   kLoopToleranceFactor * std::hypot(link_tolerance_m(r.links[l]), link_tolerance_m(r.links[m]));
+        if (2 * votes <= proposals.size()) continue;
+        const Key key{votes, r.links[l].loops_closed, r.links[l].cloud_score, r.links.size() - l};
+        if (!best || key > best->first) best = {key, {x, pose}};
+      }
+    }
+    if (!best) break;
+    r.scans[best->second.first].pose = best->second.second;
+    r.scans[best->second.first].registered = true;
+  }
+  for (ProjectScan& scan : r.scans)
+    if (!scan.registered)
+      scan.reason = scan.links.empty() ? "no accepted link connects it to the others (see its links' reasons)"
+                                       : "its accepted links do not agree on where it goes, or reach the reference";
+}
+
+// Rejects an accepted link: it leaves its scans' lists.
+void reject(ProjectResult& r, std::size_t l, const std::string& reason) {
+  ProjectLink& link = r.links[l];
+  link.accepted = false;
+  link.verdict = "inconsistent";
+  link.reason = reason;
+  for (ProjectScan& scan : r.scans) std::erase(scan.links, l);
+}
+
+// The accepted links between registered scans that agree with the placement, as pose-graph links, each with
+// its tolerance; the rest are rejected.
+struct LinkGraph {
+  std::vector<std::size_t> used;  // indices into ProjectResult::links
+  std::vector<PoseGraphLink> links;
+  std::vector<double> tolerances_m;
+
+  void erase(std::size_t e) {
+    used.erase(used.begin() + e);
+    links.erase(links.begin() + e);
+    tolerances_m.erase(tolerances_m.begin() + e);
+  }
+};
+
+LinkGraph graph_of_agreeing_links(ProjectResult& r, const std::vector<ScanExtent>& extents) {
+  LinkGraph graph;
+  for (std::size_t l = 0; l < r.links.size(); ++l) {
+    const ProjectLink& link = r.links[l];
+    if (!link.accepted) continue;
+    if (!r.scans[link.source].registered || !r.scans[link.target].registered) continue;
+    const double misfit = displacement_m(link_misfit(r.scans[link.source].pose, r.scans[link.target].pose, link.transform),
+                                         extents[link.source]);
+    const double tolerance = kLoopToleranceFactor * link_tolerance_m(link);
+    if (misfit > tolerance) {
+      reject(r, l, fmt::format("disagrees with the poses most links support by {:.3g} m (tolerance {:.3g} m)", misfit, tolerance));
+      continue;
+    }
+    graph.used.push_back(l);
+    graph.links.push_back({link.source, link.target, link.transform, extents[link.source], 1.0});
+    graph.tolerances_m.push_back(link_tolerance_m(link));
+  }
+  // Each link weighs by its precision: its refinement's residual, against the median link's. A pose its loops
+  // implied fits its pair less closely than a pair's own winner (1.2 mm against 0.4-0.7 mm on the bunny).
+  if (!graph.links.empty()) {
+    std::vector<double> rmse;
+    for (std::size_t l : graph.used) rmse.push_back(r.links[l].rmse_m);
+    const double typical_m = median(std::move(rmse));
+    for (std::size_t e = 0; e < graph.links.size(); ++e) {
+      const double own_m = r.links[graph.used[e]].rmse_m;
+      if (typical_m > 0.0 && own_m > typical_m) graph.links[e].weight = (typical_m / own_m) * (typical_m / own_m);
+    }
+  }
+  return graph;
+}
+
+// Scans held too weakly to tell from a twin placement leave the project (twin_motion.h): not registered, with
+// both placements where the twin motion is known.
+void refuse_weakly_held_scans(ProjectResult& r, const std::vector<LinkCandidates>& candidates, const LinkGraph& graph,
+                              const std::vector<ScanExtent>& extents) {
+  const std::vector<TwinHold> holds = holds_against_twins(r, candidates, graph.used, extents, 1.0);
+  for (std::size_t i = 0; i < r.scans.size(); ++i) {
+    ProjectScan& scan = r.scans[i];
+    scan.strength = scan.registered ? holds[i].strength : 0.0;
+    if (!scan.registered || holds[i].strength >= kAmbiguousMargin) continue;
+    scan.registered = false;
+    scan.reason = fmt::format(
+        "held too weakly: its links' margins (strength {:.3f} < {}) cannot tell it from a twin placement",
+        holds[i].strength, kAmbiguousMargin);
+    if (!holds[i].motion) continue;
+    scan.ambiguous = true;
+    scan.candidate_poses = {scan.pose, *holds[i].motion * scan.pose};
+    scan.reason += "; both placements are given, the one its links prefer first";
+  }
+}
+
+// The link the refined project contradicts most, beyond its tolerance, is rejected; whether there was one.
+bool reject_the_worst_misfit(ProjectResult& r, const LinkGraph& graph, const PoseGraphResult& refined) {
+  std::size_t worst = graph.used.size();
+  double worst_excess = 1.0;
+  for (std::size_t e = 0; e < graph.used.size(); ++e) {
+    const double excess = refined.residual_m[e] / (kLoopToleranceFactor * graph.tolerances_m[e]);
+    if (excess > worst_excess) worst = e, worst_excess = excess;
+  }
+  if (worst == graph.used.size()) return false;
+  reject(r, graph.used[worst], fmt::format("disagrees with the refined project by {:.3g} m (tolerance {:.3g} m)",
+                                           refined.residual_m[worst], kLoopToleranceFactor * graph.tolerances_m[worst]));
+  return true;
+}
+
+// The refined poses, the links' residuals and each scan's constraint: its links pin it along the directions
+// their surfaces face, in the project's frame.
+void adopt_refinement(ProjectResult& r, const LinkGraph& graph, const PoseGraphResult& refined) {
+  double sum_sq = 0.0;
+  for (std::size_t e = 0; e < graph.used.size(); ++e) {
+    r.links[graph.used[e]].residual_m = refined.residual_m[e];
+    sum_sq += refined.residual_m[e] * refined.residual_m[e];
+  }
+  r.global_rmse_m = graph.used.empty() ? 0.0 : std::sqrt(sum_sq / graph.used.size());
+  for (std::size_t i = 0; i < r.scans.size(); ++i)
+    if (r.scans[i].registered) r.scans[i].pose = refined.poses[i];
+  for (std::size_t l : graph.used) {
+    const ProjectLink& link = r.links[l];
+    const Eigen::Matrix3d in_project =
+        rotated_constraint(link.constraint, r.scans[link.target].pose.topLeftCorner<3, 3>());
+    r.scans[link.source].constraint += in_project;
+    r.scans[link.target].constraint += in_project;
+  }
+  for (ProjectScan& scan : r.scans) scan.constraint = normalized_constraint(scan.constraint);
+}
+
+}  // namespace
+
+void place_and_refine(const ProjectInputs& in, const std::vector<LinkCandidates>& candidates, bool levelled,
+                      ProjectResult& r) {
+  const StageTimer timer(r.timings, "refinement");
+  if (in.progress) in.progress("refinement", 0.0);
+  for (;;) {
+    check(in.cancel);
+    place_scans(r, in.extents);
+    LinkGraph graph = graph_of_agreeing_links(r, in.extents);
+    // Scans that a confident pairwise result contradicts leave the project (scan_conflicts.h).
+    refuse_conflicted_scans(r, in.extents);
+    refuse_minority_placements(r);
+    refuse_weakly_held_scans(r, candidates, graph, in.extents);
+    for (std::size_t e = graph.used.size(); e-- > 0;) {
+      const ProjectLink& link = r.links[graph.used[e]];
+      if (!r.scans[link.source].registered || !r.scans[link.target].registered) graph.erase(e);
+    }
+    std::vector<Eigen::Matrix4d> poses;
+    for (const ProjectScan& scan : r.scans) poses.push_back(scan.pose);
+    PoseGraphParams solver;
+    solver.fixed = r.reference;
+    solver.levelled = levelled;
+    if (!graph.tolerances_m.empty()) solver.huber_m = median(graph.tolerances_m);
+    const PoseGraphResult refined = optimize_pose_graph_robustly(poses, graph.links, solver);
+    if (reject_the_worst_misfit(r, graph, refined)) continue;  // then all again
+    adopt_refinement(r, graph, refined);
+    break;
+  }
+  r.scans_registered = std::count_if(r.scans.begin(), r.scans.end(), [](const ProjectScan& s) { return s.registered; });
+}
+
+}  // namespace k4reg
