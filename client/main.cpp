@@ -3,15 +3,15 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
-#include "align_command.h"
-#include "align_project_command.h"
-#include "command_error.h"
+#include "commands/align_command.h"
+#include "commands/align_project_command.h"
+#include "commands/command_error.h"
 #include "k4reg/util/error.h"
 #ifdef K4REG_REMOTE_COMMANDS
-#include "health_command.h"
-#include "load_command.h"
-#include "register_command.h"
-#include "register_project_command.h"
+#include "commands/health_command.h"
+#include "commands/load_command.h"
+#include "commands/register_command.h"
+#include "commands/register_project_command.h"
 #endif
 
 int main(int argc, char** argv) {

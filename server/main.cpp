@@ -15,16 +15,16 @@
 #include <filesystem>
 #include <fstream>
 
-#include "grpc_reflection.h"
-#include "health.h"
-#include "health_listener.h"
-#include "http_server.h"
-#include "json_log.h"
-#include "metrics.h"
-#include "peer_channel.h"
-#include "registration_service.h"
+#include "rpc/grpc_reflection.h"
+#include "observability/health.h"
+#include "observability/health_listener.h"
+#include "http/http_server.h"
+#include "observability/json_log.h"
+#include "observability/metrics.h"
+#include "peers/peer_channel.h"
+#include "rpc/registration_service.h"
 #include "server_config.h"
-#include "tls.h"
+#include "security/tls.h"
 
 namespace k4reg::service {
 namespace {

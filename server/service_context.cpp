@@ -2,10 +2,10 @@
 
 #include <fmt/format.h>
 
-#include "auth.h"
+#include "security/auth.h"
 #include "k4reg/util/error.h"
-#include "proto_convert.h"
-#include "status_mapping.h"
+#include "api/proto_convert.h"
+#include "api/status_mapping.h"
 #include "status_name.h"
 
 namespace k4reg::service {

@@ -10,17 +10,17 @@
 #include <string>
 #include <string_view>
 
-#include "job_queue.h"
+#include "jobs/job_queue.h"
 #include "k4reg/v1/registration.pb.h"
-#include "memory_budget.h"
-#include "metrics.h"
-#include "path_policy.h"
-#include "peer_pair_runner.h"
-#include "registration_job.h"
-#include "scan_cache.h"
-#include "request_log.h"
-#include "spool.h"
-#include "upload_idle_watch.h"
+#include "jobs/memory_budget.h"
+#include "observability/metrics.h"
+#include "security/path_policy.h"
+#include "peers/peer_pair_runner.h"
+#include "jobs/registration_job.h"
+#include "peers/scan_cache.h"
+#include "observability/request_log.h"
+#include "jobs/spool.h"
+#include "rpc/upload_idle_watch.h"
 
 namespace k4reg::service {
 

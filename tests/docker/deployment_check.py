@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Checks docker/ (Dockerfile, compose.yaml, k8s/) against the real programs: option and variable names,
 defaults and ports from `k4reg-server --help`, client flags from `k4reg health|load --help`, probe names
-from server/health.h, runtime packages from `ldd` + `dpkg -S` of the built binaries.
+from server/observability/health.h, runtime packages from `ldd` + `dpkg -S` of the built binaries.
 
     deployment_check.py --repo . --bin-dir build/bin      # prints the problems, exit code 1 if any
 
@@ -84,7 +84,7 @@ def program_options(*command):
 def load(repo, bin_dir, docker_dir=None):
     repo, bin_dir = Path(repo), Path(bin_dir)
     docker = Path(docker_dir) if docker_dir else repo / "docker"
-    health_h = (repo / "server/health.h").read_text()
+    health_h = (repo / "server/observability/health.h").read_text()
     version = re.search(r"project\(k4reg VERSION (\S+)", (repo / "CMakeLists.txt").read_text())
     manifests = []
     for path in sorted((docker / "k8s").glob("*.yaml")):
@@ -317,7 +317,7 @@ def check_dockerfile(d, problems):
                         "the image must set K4REG_HEALTH_LISTEN to a fixed port the HEALTHCHECK can reach on loopback")
         if "--service" in command[:-1]:
             service = command[command.index("--service") + 1]
-            problems.expect(service in d.health_names.values(), where, f"HEALTHCHECK --service {service!r} is not in server/health.h")
+            problems.expect(service in d.health_names.values(), where, f"HEALTHCHECK --service {service!r} is not in server/observability/health.h")
 
     user = runtime.last("USER")
     uid = user.arguments.split(":")[0] if user else "0"
@@ -459,7 +459,7 @@ def check_kubernetes(d, problems):
         problems.expect(grpc.get("port") == ports.get("health"), where,
                         f"{probe} must use the health listener's port {ports.get('health')} (K4REG_HEALTH_LISTEN)")
         problems.expect(grpc.get("service") == d.health_names.get(name), where,
-                        f"{probe} service {grpc.get('service')!r} must be {d.health_names.get(name)!r} (server/health.h)")
+                        f"{probe} service {grpc.get('service')!r} must be {d.health_names.get(name)!r} (server/observability/health.h)")
     check_stop_timeout(problems, where, pod["spec"].get("terminationGracePeriodSeconds", 30), values)
     problems.expect(float(values["K4REG_MAX_CONNECTION_AGE_S"]) > 0, where,
                     "K4REG_MAX_CONNECTION_AGE_S must be set, so long-lived HTTP/2 connections rebalance over replicas")

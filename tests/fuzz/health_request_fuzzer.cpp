@@ -1,13 +1,13 @@
-// The health listener's request parser (server/health_request.h): arbitrary bytes as what a connection sent.
-// Beyond "no crash, no exception": every outcome keeps the parser's promises, and an outcome once decided
-// stays so whatever bytes follow (the listener stops reading there).
+// The health listener's request parser (server/observability/health_request.h): arbitrary bytes as what a
+// connection sent. Beyond "no crash, no exception": every outcome keeps the parser's promises, and an outcome
+// once decided stays so whatever bytes follow (the listener stops reading there).
 #include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
 
 #include "fuzz_checks.h"
-#include "health_request.h"
+#include "observability/health_request.h"
 
 namespace {
 

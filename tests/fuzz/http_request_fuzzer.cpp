@@ -9,13 +9,13 @@
 #include <string>
 #include <string_view>
 
-#include "auth.h"
-#include "http_access.h"
-#include "http_body.h"
-#include "http_exchange.h"
-#include "http_json.h"
+#include "security/auth.h"
+#include "security/http_access.h"
+#include "http/http_body.h"
+#include "http/http_exchange.h"
+#include "http/http_json.h"
 #include "request_checks.h"
-#include "request_log.h"
+#include "observability/request_log.h"
 
 namespace {
 

@@ -11,7 +11,7 @@
 #include "fuzz_checks.h"
 #include "k4reg/io/cloud_io.h"
 #include "k4reg/v1/registration.pb.h"
-#include "proto_convert.h"
+#include "api/proto_convert.h"
 
 namespace k4reg::fuzz {
 

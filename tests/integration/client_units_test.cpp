@@ -7,13 +7,13 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "channel.h"
-#include "latency_stats.h"
-#include "progress_bar.h"
-#include "project_convert.h"
-#include "project_mapping.h"
-#include "project_report.h"
-#include "proto_mapping.h"
+#include "remote/channel.h"
+#include "reports/latency_stats.h"
+#include "reports/progress_bar.h"
+#include "api/project_convert.h"
+#include "remote/project_mapping.h"
+#include "reports/project_report.h"
+#include "remote/proto_mapping.h"
 
 namespace k4reg::cli {
 namespace {

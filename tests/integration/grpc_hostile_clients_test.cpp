@@ -19,7 +19,7 @@
 #include <thread>
 #include <vector>
 
-#include "http_connection.h"
+#include "http/http_connection.h"
 #include "raw_connection.h"
 #include "test_support.h"
 

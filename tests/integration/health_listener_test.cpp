@@ -1,7 +1,7 @@
-// The health listener (--health-listen, server/health_listener.h) against hostile clients over loopback, on the
-// real server: odd, malformed and oversized requests get their status and cost nothing else, and slow or idle
-// connections never keep GET /healthz from answering within a second. Its request parser
-// (server/health_request.h) on its own first.
+// The health listener (--health-listen, server/observability/health_listener.h) against hostile clients over
+// loopback, on the real server: odd, malformed and oversized requests get their status and cost nothing else,
+// and slow or idle connections never keep GET /healthz from answering within a second. Its request parser
+// (server/observability/health_request.h) on its own first.
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -18,8 +18,8 @@
 #include <utility>
 #include <vector>
 
-#include "health_listener.h"
-#include "health_request.h"
+#include "observability/health_listener.h"
+#include "observability/health_request.h"
 #include "raw_connection.h"
 #include "test_support.h"
 

@@ -10,8 +10,8 @@
 #include <Eigen/LU>
 #include <set>
 
-#include "http_json.h"
-#include "http_routes.h"
+#include "http/http_json.h"
+#include "http/http_routes.h"
 #include "k4reg/registration/metrics.h"
 #include "test_support.h"
 

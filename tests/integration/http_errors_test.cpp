@@ -6,7 +6,7 @@
 
 #include <thread>
 
-#include "http_json.h"
+#include "http/http_json.h"
 #include "test_support.h"
 
 namespace k4reg::test {

@@ -5,7 +5,7 @@
 
 #include <sstream>
 
-#include "http_json.h"
+#include "http/http_json.h"
 #include "test_support.h"
 
 namespace k4reg::test {

@@ -1,7 +1,7 @@
-// The HTTP listener (--http-listen, server/http_server.h) against hostile clients over loopback, on the real
+// The HTTP listener (--http-listen, server/http/http_server.h) against hostile clients over loopback, on the real
 // server: empty, oversized, duplicated and flooded header fields, odd methods, junk after a multipart form's
 // closing delimiter, stalled bodies and slow heads each cost their own connection and nothing else, within the
-// listener's limits (server/http_connection.h), with the status that names them; and what is open without a
+// listener's limits (server/http/http_connection.h), with the status that names them; and what is open without a
 // token: --public-metrics, --reflection, the page's headers and the same-origin rule.
 #include <grpcpp/generic/generic_stub.h>
 #include <gtest/gtest.h>
@@ -16,7 +16,7 @@
 #include <thread>
 #include <vector>
 
-#include "http_connection.h"
+#include "http/http_connection.h"
 #include "raw_connection.h"
 #include "test_support.h"
 

@@ -4,7 +4,7 @@
 
 #include <random>
 
-#include "scan_cache.h"
+#include "peers/scan_cache.h"
 
 namespace k4reg::test {
 namespace {

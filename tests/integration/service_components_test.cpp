@@ -9,13 +9,13 @@
 #include <thread>
 
 #include "k4reg/util/crc32c.h"
-#include "job_queue.h"
+#include "jobs/job_queue.h"
 #include "k4reg/util/error.h"
-#include "memory_budget.h"
-#include "path_policy.h"
-#include "proto_convert.h"
-#include "spool.h"
-#include "status_mapping.h"
+#include "jobs/memory_budget.h"
+#include "security/path_policy.h"
+#include "api/proto_convert.h"
+#include "jobs/spool.h"
+#include "api/status_mapping.h"
 #include "test_support.h"
 
 namespace k4reg::test {

@@ -18,8 +18,8 @@
 #include <thread>
 
 #include "k4reg/io/cloud_io.h"
-#include "peer_reply.h"
-#include "proto_convert.h"
+#include "peers/peer_reply.h"
+#include "api/proto_convert.h"
 #include "test_support.h"
 
 namespace k4reg::test {

@@ -2,7 +2,7 @@
 // as `k4reg align-project` for the same request and seed, the events of the stream, and malformed projects.
 #include <gtest/gtest.h>
 
-#include "http_json.h"
+#include "http/http_json.h"
 #include "k4reg/io/cloud_io.h"
 #include "k4reg/util/crc32c.h"
 #include "test_support.h"

@@ -6,7 +6,7 @@
 
 #include "k4reg/io/cloud_io.h"
 #include "k4reg/registration/registration.h"
-#include "proto_convert.h"
+#include "api/proto_convert.h"
 #include "test_support.h"
 
 namespace k4reg::test {

@@ -13,7 +13,7 @@
 #include "k4reg/io/las_io.h"
 #include "k4reg/io/ptx_io.h"
 #include "k4reg/registration/registration.h"
-#include "proto_convert.h"
+#include "api/proto_convert.h"
 #include "../unit/simulated_lab_pair.h"
 #include "test_support.h"
 

@@ -7,7 +7,7 @@
 #include "k4reg/io/cloud_io.h"
 #include "k4reg/registration/metrics.h"
 #include "k4reg/registration/registration.h"
-#include "proto_convert.h"
+#include "api/proto_convert.h"
 #include "sim/scanner.h"
 #include "sim/scene.h"
 #include "test_support.h"

@@ -16,7 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "http_lib.h"
+#include "http/http_lib.h"
 #include "k4reg/v1/registration.grpc.pb.h"
 #include "sim/scanner.h"
 
