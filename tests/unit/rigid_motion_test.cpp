@@ -20,7 +20,7 @@ Eigen::Matrix4d turn_about(const Eigen::Vector3d& centre, double angle_deg) {
 }
 
 TEST(RigidMotion, PosesAreComparedAtTheScanNotAtTheOrigin) {
-  for (const Eigen::Vector3d centre : {Eigen::Vector3d(0.1, 0.0, 0.0), Eigen::Vector3d(29.0, 29.0, 0.0)}) {
+  for (const Eigen::Vector3d& centre : {Eigen::Vector3d(0.1, 0.0, 0.0), Eigen::Vector3d(29.0, 29.0, 0.0)}) {
     const Eigen::Matrix4d a = Eigen::Matrix4d::Identity(), b = turn_about(centre, 1.0);
     // 1 degree about the scan's centre moves its centre nowhere: within a 2-degree, 1 cm bar it is the same pose,
     // though its raw translation is 0.7 m where the scan lies 41 m from the origin.
@@ -36,7 +36,7 @@ TEST(RigidMotion, PosesAreComparedAtTheScanNotAtTheOrigin) {
 
 TEST(RigidMotion, DisplacementIsMeasuredWhereTheScanIs) {
   // A scan 0.2 m across: a 0.1-degree turn about its centre moves its points by 0.35 mm wherever it lies.
-  for (const Eigen::Vector3d centre : {Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(29.0, -29.0, 12.0)}) {
+  for (const Eigen::Vector3d& centre : {Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(29.0, -29.0, 12.0)}) {
     const ScanExtent scan{centre, 0.2};
     EXPECT_NEAR(displacement_m(turn_about(centre, 0.1), scan), 0.2 * 0.1 * M_PI / 180.0, 1e-9) << centre.transpose();
     Eigen::Matrix4d shifted = Eigen::Matrix4d::Identity();
