@@ -55,7 +55,7 @@ struct Options {
   std::string only;
   std::string cache_dir = "build-bench/bench-cache";
   std::string results_dir = "bench/results";
-  std::string markdown = "bench/RESULTS.md";
+  std::string markdown = "bench/results/comparison-with-pcl.md";
   std::string data_dir = "/work/shared/data";
   int memory_cap_mb = 12000;
 };
@@ -593,9 +593,9 @@ int main(int argc, char** argv) {
   std::string job_text;
   worker->add_option("--job", job_text, "the job as JSON")->required();
   CLI::App* voxel = app.add_subcommand("voxel-report", "turn voxel_grid_bench's JSON into the voxel block");
-  std::string voxel_json;
+  std::string voxel_json, voxel_markdown = "bench/RESULTS.md";
   voxel->add_option("--json", voxel_json, "Google Benchmark JSON output")->required();
-  voxel->add_option("--markdown", o.markdown, "file whose voxel block is replaced")->capture_default_str();
+  voxel->add_option("--markdown", voxel_markdown, "file whose voxel block is replaced")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -606,7 +606,7 @@ int main(int argc, char** argv) {
       std::printf("RESULT %s\n", result.dump().c_str());
       return 0;
     }
-    if (voxel->parsed()) return voxel_report(voxel_json, o.markdown);
+    if (voxel->parsed()) return voxel_report(voxel_json, voxel_markdown);
     std::string command = "k4reg-bench-compare";
     // A progress report names the command that makes (and continues) the runs it reports.
     for (int i = 1; i < argc; ++i)

@@ -1,5 +1,5 @@
 // The comparison's data model (suites, cases, runs) and its outputs: per-run and per-row CSV files,
-// the markdown block of bench/RESULTS.md (the paper's Tables 2-4 with PCL beside us, plus every row in
+// the markdown block of bench/results/comparison-with-pcl.md (the paper's Tables 2-4 with PCL beside us, plus every row in
 // detail) and gnuplot scripts for the plots.
 #pragma once
 
@@ -101,7 +101,7 @@ struct Report {
 // -time-vs-size.gp (inline data; run by bench/run.sh to make the PNGs next to them).
 void write_outputs(const Report& report, const std::string& dir);
 
-// The markdown block for RESULTS.md.
+// The markdown block for bench/results/comparison-with-pcl.md.
 std::string markdown(const Report& report, const std::string& results_dir_in_repo);
 
 }  // namespace k4reg::bench

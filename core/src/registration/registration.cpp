@@ -313,275 +313,364 @@ Eigen::Matrix4d to_local_frames(const Eigen::Matrix4d& file, const Eigen::Vector
   return t;
 }
 
-// The single-scale pipeline, steps 1-5, at minimum scale sigma. Given poses (files' frames) replace steps 2-3:
-// the symmetry guard and the verdict judge them instead of what 4PCS would find.
-ScaleAttempt register_at_scale(const PreparedScan& source_scan, const PreparedScan& target_scan,
-                               const RegistrationParams& params, double sigma,
-                               const std::vector<Eigen::Matrix4d>& given_poses, const CancellationToken* cancel,
-                               const ProgressCallback& progress) {
-  const PointCloud &source = source_scan.cloud(), &target = target_scan.cloud();
-  RegistrationResult result;
-  result.seed = params.seed;
-  result.source_points = source.size();
-  result.target_points = target.size();
-  result.min_scale_m_used = sigma;
-  StageRunner stages(result, progress);
+// The outcome of steps 2-4 at one scale: the chosen coarse alignment, the smallest overlap searched (what a true
+// pose must explain) and the bases tried in all rounds.
+struct CoarseOutcome {
+  CoarseAlignment chosen;
+  double overlap_searched = 0.0;
+  int bases_tried = 0;
+};
 
-  // 1. Voxel grid at the minimum scale (paper Sec. 2.1).
-  // Named references rather than structured bindings: lambdas below use them, and clang < 16 cannot capture
-  // a structured binding.
-  const auto voxelised = stages.run("voxel_grid", [&] {
-    return std::make_pair(&source_scan.voxels(sigma, cancel), &target_scan.voxels(sigma, cancel));
-  });
-  const VoxelizedCloud &source_voxels = *voxelised.first, &target_voxels = *voxelised.second;
-  result.source_voxels = source_voxels.cloud.size();
-  result.target_voxels = target_voxels.cloud.size();
-  check_geometry(source_voxels.cloud.points, sigma, "source");
-  check_geometry(target_voxels.cloud.points, sigma, "target");
+using PyramidPair = std::pair<const IcpPyramid&, const IcpPyramid&>;  // source, target
 
-  // The ICP pyramids serve the symmetry guard and the final refinement; built once, when first needed.
-  IcpParams icp_params;
-  icp_params.voxel_m = sigma;
-  icp_params.max_iterations = params.icp_max_iterations;
-  icp_params.levelled = params.levelled;
-  using Pyramids = std::pair<const IcpPyramid&, const IcpPyramid&>;  // source, target
-  std::optional<Pyramids> pyramids;
-  auto icp_pyramids = [&]() -> const Pyramids& {
-    if (!pyramids)
-      pyramids.emplace(stages.run("icp_setup", [&] {
-        return Pyramids(source_scan.pyramid(sigma, icp_params, false, cancel),
-                        target_scan.pyramid(sigma, icp_params, true, cancel));
-      }));
-    return *pyramids;
-  };
-  // The point precision every 4PCS tolerance derives from. Repeated keypoints of two scans lie within
-  // about 2 sigma of each other (measured on the simulated lab and the bunny); plain 4PCS works on a
-  // coarser grid, whose spacing it is.
-  const bool plain = params.method == CoarseMethod::kPlain4pcs;
-  const double delta = !plain ? 2.0 * sigma : stages.run("plain_grid", [&] {
-    return params.plain_voxel_m > 0 ? params.plain_voxel_m : spacing_for_count(source_voxels.cloud, 4 * sigma, 2000);
+// The single-scale pipeline for one pair at minimum scale sigma, one named step per method: the voxel grid and
+// the free space (on construction), then either the search (steps 2-4) or given poses judged in its place, then
+// refinement and verdict (step 5). The steps share the voxels, ICP pyramids, free space and point sets.
+class ScalePipeline {
+ public:
+  ScalePipeline(const PreparedScan& source, const PreparedScan& target, const RegistrationParams& params,
+                double sigma, const CancellationToken* cancel, const ProgressCallback& progress)
+      : source_scan_(source), target_scan_(target), params_(params), sigma_(sigma), cancel_(cancel),
+        progress_(progress), stages_(result_, progress) {
+    result_.seed = params.seed;
+    result_.source_points = source.cloud().size();
+    result_.target_points = target.cloud().size();
+    result_.min_scale_m_used = sigma;
+    icp_params_.voxel_m = sigma;
+    icp_params_.max_iterations = params.icp_max_iterations;
+    icp_params_.levelled = params.levelled;
+    voxelise();
+    see_free_space();
+  }
+  ScalePipeline(const ScalePipeline&) = delete;
+  ScalePipeline& operator=(const ScalePipeline&) = delete;
+
+  // Steps 2-4: rounds of bases (with the overlap automatic, fresh ones for smaller overlaps while no pose is well
+  // supported), on the intensity signal first and the geometric one where intensity poses are weak.
+  CoarseOutcome search();
+  // Given poses (files' frames) in place of steps 2-3: the symmetry guard ranks them.
+  CoarseOutcome given(const std::vector<Eigen::Matrix4d>& poses);
+  // Step 5: refinement, the verdict, and the result in the files' frames.
+  ScaleAttempt refine(const CoarseOutcome& coarse);
+
+ private:
+  void voxelise();
+  void see_free_space();
+  const PyramidPair& icp_pyramids();
+  const PointSets& sets_for(KeypointSignal signal);
+  CoarseAlignment coarse(KeypointSignal signal, double overlap, std::uint64_t seed);
+  std::vector<double> overlaps() const;
+  void flag_ambiguity(const Verdict& verdict, double needed, const SurfaceBar& bar);
+  void to_files_frames(const Eigen::Matrix4d& local, const CoarseAlignment& chosen);
+
+  const PreparedScan &source_scan_, &target_scan_;
+  const RegistrationParams& params_;
+  const double sigma_;
+  const CancellationToken* cancel_;
+  const ProgressCallback& progress_;
+  RegistrationResult result_;
+  StageRunner stages_;
+  IcpParams icp_params_;
+  const VoxelizedCloud *source_voxels_ = nullptr, *target_voxels_ = nullptr;
+  std::optional<PyramidPair> pyramids_;  // built when first needed
+  bool plain_ = false;
+  double delta_ = 0.0;  // the point precision every 4PCS tolerance derives from
+  ScanViews views_;
+  const ScanViews* seen_ = nullptr;   // what the guard and the scorer weigh: views_ where free space is used
+  std::deque<PointSets> point_sets_;  // one per signal asked for so far (a deque: CoarseAlignment points into it)
+};
+
+// 1. Voxel grid at the minimum scale (paper Sec. 2.1), and the 4PCS precision. Repeated keypoints of two scans
+//    lie within about 2 sigma of each other (measured on the simulated lab and the bunny); plain 4PCS works on a
+//    coarser grid, whose spacing it is.
+void ScalePipeline::voxelise() {
+  const auto voxelised = stages_.run("voxel_grid", [&] {
+    return std::make_pair(&source_scan_.voxels(sigma_, cancel_), &target_scan_.voxels(sigma_, cancel_));
   });
-  // Free space (free_space.h), seen from the scanners or along the cameras (free_space_from). Raw points fill
-  // every cell.
-  const double margin_m = 3.0 * delta;
-  ScanViews views;
-  const FreeSpaceFrom from = stages.run("scanner_position", [&] {
-    return free_space_from(params.free_space, source_scan, target_scan, sigma, cancel);
+  source_voxels_ = voxelised.first;
+  target_voxels_ = voxelised.second;
+  result_.source_voxels = source_voxels_->cloud.size();
+  result_.target_voxels = target_voxels_->cloud.size();
+  check_geometry(source_voxels_->cloud.points, sigma_, "source");
+  check_geometry(target_voxels_->cloud.points, sigma_, "target");
+  plain_ = params_.method == CoarseMethod::kPlain4pcs;
+  delta_ = !plain_ ? 2.0 * sigma_ : stages_.run("plain_grid", [&] {
+    return params_.plain_voxel_m > 0 ? params_.plain_voxel_m : spacing_for_count(source_voxels_->cloud, 4 * sigma_, 2000);
+  });
+}
+
+// Free space (free_space.h), seen from the scanners or along the cameras (free_space_from). Raw points fill every
+// cell.
+void ScalePipeline::see_free_space() {
+  const double margin_m = 3.0 * delta_;
+  const FreeSpaceFrom from = stages_.run("scanner_position", [&] {
+    return free_space_from(params_.free_space, source_scan_, target_scan_, sigma_, cancel_);
   });
   if (from == FreeSpaceFrom::kScanners)
-    views = {&target_scan.free_space(margin_m), Viewpoint::at(source_scan.scanner_local(cancel)),
-             Viewpoint::at(target_scan.scanner_local(cancel))};
+    views_ = {&target_scan_.free_space(margin_m), Viewpoint::at(source_scan_.scanner_local(cancel_)),
+              Viewpoint::at(target_scan_.scanner_local(cancel_))};
   if (from == FreeSpaceFrom::kCameras)
-    views = {&target_scan.view_free_space(sigma, margin_m, cancel), Viewpoint::along(*source_scan.view_direction(sigma, cancel)),
-             Viewpoint::along(*target_scan.view_direction(sigma, cancel))};
-  result.source_scanner = source_scan.scanner_known(cancel);
-  result.target_scanner = target_scan.scanner_known(cancel);
-  result.free_space_used = views.target_free_space != nullptr;
-  const ScanViews* seen = result.free_space_used ? &views : nullptr;  // what the guard and the scorer weigh
+    views_ = {&target_scan_.view_free_space(sigma_, margin_m, cancel_),
+              Viewpoint::along(*source_scan_.view_direction(sigma_, cancel_)),
+              Viewpoint::along(*target_scan_.view_direction(sigma_, cancel_))};
+  result_.source_scanner = source_scan_.scanner_known(cancel_);
+  result_.target_scanner = target_scan_.scanner_known(cancel_);
+  result_.free_space_used = views_.target_free_space != nullptr;
+  seen_ = result_.free_space_used ? &views_ : nullptr;
+}
 
-  // 2. The point sets 4PCS runs on: DoG keypoints (K-4PCS) or a coarser voxel grid (plain 4PCS).
-  std::deque<PointSets> point_sets;  // one per signal asked for so far (a deque: CoarseAlignment points into it)
-  auto sets_for = [&](KeypointSignal signal) -> const PointSets& {
-    const bool intensity = source.has_intensity() && target.has_intensity();
-    for (const PointSets& sets : point_sets)
-      if (sets.signal == (plain ? "voxels" : surface_signal_name(signal, intensity))) return sets;
-    PointSets& sets = point_sets.emplace_back();
-    if (!plain) {
-      stages.run("keypoints", [&] {
-        const DogParams dog{sigma, params.octaves, params.scales_per_octave, params.min_contrast};
-        const ScanKeypoints& from = source_scan.keypoints(sigma, signal, intensity, dog, cancel);
-        const ScanKeypoints& to = target_scan.keypoints(sigma, signal, intensity, dog, cancel);
-        sets.signal = to.signal;
-        sets.source = from.points, sets.source_labels = from.labels;
-        sets.target = to.points, sets.target_labels = to.labels;
-        return 0;
-      });
-    } else {
-      stages.run("plain_grid", [&] {
-        sets.source = voxel_grid(source_voxels.cloud, delta, cancel).cloud.points;
-        sets.target = voxel_grid(target_voxels.cloud, delta, cancel).cloud.points;
-        return 0;
-      });
-      sets.signal = "voxels";
-    }
-    return sets;
-  };
+// The ICP pyramids serve the symmetry guard and the final refinement.
+const PyramidPair& ScalePipeline::icp_pyramids() {
+  if (!pyramids_)
+    pyramids_.emplace(stages_.run("icp_setup", [&] {
+      return PyramidPair(source_scan_.pyramid(sigma_, icp_params_, false, cancel_),
+                         target_scan_.pyramid(sigma_, icp_params_, true, cancel_));
+    }));
+  return *pyramids_;
+}
 
-  // 2-4. Coarse alignment on one signal with one round of bases: 4PCS, then the symmetry guard.
-  auto coarse = [&](KeypointSignal signal, double overlap, std::uint64_t seed) {
-    const PointSets& sets = sets_for(signal);
-    constexpr std::size_t kMinKeypoints = 8;
-    if (!plain && (sets.source.size() < kMinKeypoints || sets.target.size() < kMinKeypoints))
-      fail(ErrorCode::kFailedPrecondition,
-           "too few keypoints (source " + std::to_string(sets.source.size()) + ", target " +
-               std::to_string(sets.target.size()) + ")");
-    CoarseAlignment out;
-    out.signal = sets.signal;
-    out.source_keypoints = sets.source.size();
-    out.target_keypoints = sets.target.size();
-    out.source_points = &sets.source;
-    out.target_points = &sets.target;
-    out.overlap = overlap;
-
-    // 3. 4PCS on the two point sets (paper Sec. 2.2).
-    const FourPcsResult matched = stages.run("matching", [&] {
-      FourPcsParams four{delta, overlap, params.max_bases, params.hypotheses_kept, seed};
-      four.levelled = params.levelled;
-      if (!plain) four.source_labels = &sets.source_labels, four.target_labels = &sets.target_labels;
-      return match_4pcs(sets.source, sets.target, four, cancel, progress);
+// 2. The point sets 4PCS runs on: DoG keypoints (K-4PCS) or a coarser voxel grid (plain 4PCS).
+const PointSets& ScalePipeline::sets_for(KeypointSignal signal) {
+  const bool intensity = source_scan_.cloud().has_intensity() && target_scan_.cloud().has_intensity();
+  for (const PointSets& sets : point_sets_)
+    if (sets.signal == (plain_ ? "voxels" : surface_signal_name(signal, intensity))) return sets;
+  PointSets& sets = point_sets_.emplace_back();
+  if (!plain_) {
+    stages_.run("keypoints", [&] {
+      const DogParams dog{sigma_, params_.octaves, params_.scales_per_octave, params_.min_contrast};
+      const ScanKeypoints& from = source_scan_.keypoints(sigma_, signal, intensity, dog, cancel_);
+      const ScanKeypoints& to = target_scan_.keypoints(sigma_, signal, intensity, dog, cancel_);
+      sets.signal = to.signal;
+      sets.source = from.points, sets.source_labels = from.labels;
+      sets.target = to.points, sets.target_labels = to.labels;
+      return 0;
     });
-    out.bases_tried = matched.bases_tried;
-
-    // 4. Symmetry guard: settle each distinct hypothesis with a short coarse ICP and re-score it on the
-    //    voxelised clouds, where the furniture that breaks a room's symmetry is visible.
-    const auto& icp = icp_pyramids();
-    out.guarded = stages.run("symmetry_guard", [&] {
-      return rank_hypotheses(icp.first, icp.second, matched.hypotheses, overlap, seen,
-                             params.levelled, cancel);
+  } else {
+    stages_.run("plain_grid", [&] {
+      sets.source = voxel_grid(source_voxels_->cloud, delta_, cancel_).cloud.points;
+      sets.target = voxel_grid(target_voxels_->cloud, delta_, cancel_).cloud.points;
+      return 0;
     });
-    return out;
-  };
+    sets.signal = "voxels";
+  }
+  return sets;
+}
 
-  // Intensity first, as in the paper. Where its keypoints do not repeat between the scans (dark, noisy
-  // returns at grazing incidence outdoors, or a constant intensity field), the best pose it finds
-  // explains the clouds poorly or none is found at all; then the geometric signal gets its turn, and
-  // the pose the clouds support better stands (the cloud score does not depend on the signal).
-  // With the overlap left automatic, rounds of fresh bases follow while no pose is well supported.
-  const bool may_fall_back =
-      !plain && params.signal == KeypointSignal::kAuto && source.has_intensity() && target.has_intensity();
-  std::vector<double> overlaps{params.overlap};
-  if (params.overlap == 0.0) overlaps.assign(std::begin(kAutoOverlaps), std::end(kAutoOverlaps));
+// 2-4. Coarse alignment on one signal with one round of bases: 4PCS, then the symmetry guard.
+CoarseAlignment ScalePipeline::coarse(KeypointSignal signal, double overlap, std::uint64_t seed) {
+  const PointSets& sets = sets_for(signal);
+  constexpr std::size_t kMinKeypoints = 8;
+  if (!plain_ && (sets.source.size() < kMinKeypoints || sets.target.size() < kMinKeypoints))
+    fail(ErrorCode::kFailedPrecondition,
+         "too few keypoints (source " + std::to_string(sets.source.size()) + ", target " +
+             std::to_string(sets.target.size()) + ")");
+  CoarseAlignment out;
+  out.signal = sets.signal;
+  out.source_keypoints = sets.source.size();
+  out.target_keypoints = sets.target.size();
+  out.source_points = &sets.source;
+  out.target_points = &sets.target;
+  out.overlap = overlap;
+
+  // 3. 4PCS on the two point sets (paper Sec. 2.2).
+  const FourPcsResult matched = stages_.run("matching", [&] {
+    FourPcsParams four{delta_, overlap, params_.max_bases, params_.hypotheses_kept, seed};
+    four.levelled = params_.levelled;
+    if (!plain_) four.source_labels = &sets.source_labels, four.target_labels = &sets.target_labels;
+    return match_4pcs(sets.source, sets.target, four, cancel_, progress_);
+  });
+  out.bases_tried = matched.bases_tried;
+
+  // 4. Symmetry guard: settle each distinct hypothesis with a short coarse ICP and re-score it on the
+  //    voxelised clouds, where the furniture that breaks a room's symmetry is visible.
+  const PyramidPair& icp = icp_pyramids();
+  out.guarded = stages_.run("symmetry_guard", [&] {
+    return rank_hypotheses(icp.first, icp.second, matched.hypotheses, overlap, seen_, params_.levelled, cancel_);
+  });
+  return out;
+}
+
+// The overlaps whose bases are searched, in turn: the given one, or the automatic rounds.
+std::vector<double> ScalePipeline::overlaps() const {
+  if (params_.overlap == 0.0) return {std::begin(kAutoOverlaps), std::end(kAutoOverlaps)};
+  return {params_.overlap};
+}
+
+// Intensity first, as in the paper. Where its keypoints do not repeat between the scans (dark, noisy returns at
+// grazing incidence outdoors, or a constant intensity field), the best pose it finds explains the clouds poorly or
+// none is found at all; then the geometric signal gets its turn, and the pose the clouds support better stands
+// (the cloud score does not depend on the signal).
+CoarseOutcome ScalePipeline::search() {
+  const bool may_fall_back = !plain_ && params_.signal == KeypointSignal::kAuto &&
+                             source_scan_.cloud().has_intensity() && target_scan_.cloud().has_intensity();
+  const std::vector<double> rounds = overlaps();
   std::optional<CoarseAlignment> chosen;
   std::optional<Error> failure;
-  int bases = 0;
-  std::size_t rounds_run = 0;
-  if (!given_poses.empty()) {
-    CoarseAlignment& judged = chosen.emplace();
-    judged.signal = "given";
-    judged.overlap = overlaps.front();
-    std::vector<Hypothesis> hypotheses(given_poses.size());
-    for (std::size_t i = 0; i < given_poses.size(); ++i)
-      hypotheses[i].transform = to_local_frames(given_poses[i], source.origin_m, target.origin_m);
-    const auto& icp = icp_pyramids();
-    judged.guarded = stages.run("symmetry_guard", [&] {
-      return rank_hypotheses(icp.first, icp.second, std::move(hypotheses), judged.overlap, seen,
-                             params.levelled, cancel);
-    });
-    rounds_run = 1;
-  }
-  for (std::size_t round = 0; round < overlaps.size() && given_poses.empty(); ++round) {
-    ++rounds_run;
+  CoarseOutcome out;
+  for (std::size_t round = 0; round < rounds.size(); ++round) {
+    out.overlap_searched = rounds[round];
     // Round 0 keeps the caller's seed; later rounds draw fresh bases.
-    const std::uint64_t seed = params.seed + 0x9E3779B97F4A7C15ULL * round;
+    const std::uint64_t seed = params_.seed + 0x9E3779B97F4A7C15ULL * round;
     auto attempt = [&](KeypointSignal signal) {
       try {
-        CoarseAlignment candidate = coarse(signal, overlaps[round], seed);
-        bases += candidate.bases_tried;
+        CoarseAlignment candidate = coarse(signal, rounds[round], seed);
+        out.bases_tried += candidate.bases_tried;
         if (!chosen || candidate.best().cloud_score > chosen->best().cloud_score) chosen = std::move(candidate);
       } catch (const Error& e) {
         if (e.code() != ErrorCode::kFailedPrecondition) throw;
         if (!failure) failure = e;
       }
     };
-    attempt(params.signal);
-    const double fallback = result.free_space_used ? kFullySupportedWithFreeSpace : kSignalFallback;
+    attempt(params_.signal);
+    const double fallback = result_.free_space_used ? kFullySupportedWithFreeSpace : kSignalFallback;
     if (may_fall_back && (!chosen || chosen->best().cloud_score < fallback)) attempt(KeypointSignal::kGeometric);
-    if (chosen && chosen->best().cloud_score >= well_supported(overlaps[round], result.free_space_used)) break;
+    if (chosen && chosen->best().cloud_score >= well_supported(rounds[round], result_.free_space_used)) break;
   }
   if (!chosen) throw *failure;
-  result.signal = chosen->signal;
-  result.source_keypoints = chosen->source_keypoints;
-  result.target_keypoints = chosen->target_keypoints;
-  result.bases_tried = bases;
-  result.overlap_used = chosen->overlap;
+  out.chosen = std::move(*chosen);
+  return out;
+}
 
-  // 5. ICP refinement on the voxelised clouds (or just the quality figures with --no-icp). Where
-  //    runner-ups come close, each is refined fully and judged on what symmetry does not copy; every
-  //    refined pose is scored again (pose_score.h).
-  const auto& icp = icp_pyramids();
-  IcpParams final_params = icp_params;
-  if (!params.icp) final_params.max_iterations = 0;  // quality figures only, at the finest stage
-  const PoseScorer scorer(icp.first, icp.second, seen, result.overlap_used);
-  const SurfaceBar bar(target_scan, sigma, cancel);
+CoarseOutcome ScalePipeline::given(const std::vector<Eigen::Matrix4d>& poses) {
+  CoarseOutcome out;
+  out.overlap_searched = overlaps().front();
+  CoarseAlignment& judged = out.chosen;
+  judged.signal = "given";
+  judged.overlap = out.overlap_searched;
+  std::vector<Hypothesis> hypotheses(poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    hypotheses[i].transform = to_local_frames(poses[i], source_scan_.cloud().origin_m, target_scan_.cloud().origin_m);
+  const PyramidPair& icp = icp_pyramids();
+  judged.guarded = stages_.run("symmetry_guard", [&] {
+    return rank_hypotheses(icp.first, icp.second, std::move(hypotheses), judged.overlap, seen_, params_.levelled,
+                           cancel_);
+  });
+  return out;
+}
+
+// 5. ICP refinement on the voxelised clouds (or just the quality figures with --no-icp). Where runner-ups come
+//    close, each is refined fully and judged on what symmetry does not copy; every refined pose is scored again
+//    (pose_score.h).
+ScaleAttempt ScalePipeline::refine(const CoarseOutcome& coarse) {
+  const CoarseAlignment& chosen = coarse.chosen;
+  result_.signal = chosen.signal;
+  result_.source_keypoints = chosen.source_keypoints;
+  result_.target_keypoints = chosen.target_keypoints;
+  result_.bases_tried = coarse.bases_tried;
+  result_.overlap_used = chosen.overlap;
+
+  const PyramidPair& icp = icp_pyramids();
+  IcpParams final_params = icp_params_;
+  if (!params_.icp) final_params.max_iterations = 0;  // quality figures only, at the finest stage
+  const PoseScorer scorer(icp.first, icp.second, seen_, result_.overlap_used);
+  const SurfaceBar bar(target_scan_, sigma_, cancel_);
   auto judge = [&](const SymmetryGuardResult& guarded) {
-    return judge_contenders(guarded, icp.first, icp.second, final_params, scorer, bar, params.icp, sigma, stages, cancel);
+    return judge_contenders(guarded, icp.first, icp.second, final_params, scorer, bar, params_.icp, sigma_, stages_,
+                            cancel_);
   };
-  Verdict verdict = judge(chosen->guarded);
+  Verdict verdict = judge(chosen.guarded);
   // Where the verdict cannot decide and the hypotheses show the scene repeating under a shift (a corridor's
   // doors every few metres), the truth may be a shifted copy that 4PCS did not find: the guard searches
   // wider, from the verdict's winner, and the verdict judges again. Only such pairs pay for it.
-  if (params.icp && (verdict.margin < kAmbiguousMargin || verdict.disputed_by > 0.0) &&
+  if (params_.icp && (verdict.margin < kAmbiguousMargin || verdict.disputed_by > 0.0) &&
       repeats_under_a_shift(verdict.hypotheses, centroid(icp.first.stages.front().points),
                             2.0 * icp.second.stages.front().voxel_m)) {
-    const SymmetryGuardResult wider = stages.run("symmetry_guard", [&] {
-      return rank_hypotheses(icp.first, icp.second, verdict.hypotheses, result.overlap_used, seen,
-                             params.levelled, cancel, true);
+    const SymmetryGuardResult wider = stages_.run("symmetry_guard", [&] {
+      return rank_hypotheses(icp.first, icp.second, verdict.hypotheses, result_.overlap_used, seen_,
+                             params_.levelled, cancel_, true);
     });
     verdict = judge(wider);
   }
-  result.hypotheses = std::move(verdict.hypotheses);
-  result.ambiguity_margin = verdict.margin;
-  const bool on_the_surface = verdict.on_surface;
+  result_.hypotheses = std::move(verdict.hypotheses);
+  result_.ambiguity_margin = verdict.margin;
   // The winner polished on every source point at the finest stage, and below it where that is cheap
   // (fine_polish.h); with --no-icp, its quality figures only.
-  const Hypothesis& best = result.hypotheses.front();
-  const IcpResult final_icp = stages.run("polish", [&] {
-    return polish_winner(source_scan, target_scan, icp.first, icp.second, sigma, best.transform, final_params, cancel);
+  const Hypothesis& best = result_.hypotheses.front();
+  const IcpResult final_icp = stages_.run("polish", [&] {
+    return polish_winner(source_scan_, target_scan_, icp.first, icp.second, sigma_, best.transform, final_params,
+                         cancel_);
   });
-  const Eigen::Matrix4d local = params.icp ? final_icp.transform : best.transform;
-  result.icp_converged = params.icp && final_icp.converged;
-  result.icp_iterations = params.icp ? verdict.iterations + final_icp.iterations : 0;
-  result.rmse_m = final_icp.rmse_m;
-  result.overlap = final_icp.overlap;
-  result.inliers = final_icp.inliers;
-  result.constraint = normalized_constraint(final_icp.translation_information);
+  const Eigen::Matrix4d local = params_.icp ? final_icp.transform : best.transform;
+  result_.icp_converged = params_.icp && final_icp.converged;
+  result_.icp_iterations = params_.icp ? verdict.iterations + final_icp.iterations : 0;
+  result_.rmse_m = final_icp.rmse_m;
+  result_.overlap = final_icp.overlap;
+  result_.inliers = final_icp.inliers;
+  result_.constraint = normalized_constraint(final_icp.translation_information);
 
   // The smallest overlap searched sets what a true pose must explain.
-  const double needed = well_supported(overlaps[std::min(rounds_run, overlaps.size()) - 1], result.free_space_used);
-  if (!on_the_surface) {
-    result.ambiguous = true;
-    result.ambiguity_reason = fmt::format(
+  const double needed = well_supported(coarse.overlap_searched, result_.free_space_used);
+  flag_ambiguity(verdict, needed, bar);
+  result_.well_supported = verdict.on_surface && best.refined_score >= needed;
+  to_files_frames(local, chosen);
+  const bool supported = result_.well_supported;
+  return {std::move(result_), supported};
+}
+
+// Whether the result is flagged ambiguous, and why, in words.
+void ScalePipeline::flag_ambiguity(const Verdict& verdict, double needed, const SurfaceBar& bar) {
+  const Hypothesis& best = result_.hypotheses.front();
+  if (!verdict.on_surface) {
+    result_.ambiguous = true;
+    result_.ambiguity_reason = fmt::format(
         "off the surface: once refined, {:.0f} % of the source points near the target lie on its surface (true "
         "poses: {:.0f} % or more)",
         100 * best.surface_agreement, 100 * bar.required());
   } else if (best.refined_score < needed) {
-    result.ambiguous = true;
-    result.ambiguity_reason = fmt::format(
+    result_.ambiguous = true;
+    result_.ambiguity_reason = fmt::format(
         "poorly supported: the best pose explains {:.0f} % of the source once refined (true poses: {:.0f} % or more)",
         100 * best.refined_score, 100 * needed);
-  } else if (result.hypotheses.size() >= 2 && result.ambiguity_margin < ambiguous_below(result.free_space_used)) {
-    result.ambiguous = true;
-    result.ambiguity_reason = fmt::format(
+  } else if (result_.hypotheses.size() >= 2 && result_.ambiguity_margin < ambiguous_below(result_.free_space_used)) {
+    result_.ambiguous = true;
+    result_.ambiguity_reason = fmt::format(
         "a runner-up pose is nearly as well supported (margin {:.3f} < {}{}): the scene may be symmetric; see the "
         "hypotheses",
-        result.ambiguity_margin, ambiguous_below(result.free_space_used),
-        result.free_space_used ? "" : ", judged on geometry alone");
+        result_.ambiguity_margin, ambiguous_below(result_.free_space_used),
+        result_.free_space_used ? "" : ", judged on geometry alone");
   } else if (verdict.disputed_by > 0.0) {
-    result.ambiguous = true;
-    result.ambiguity_reason = fmt::format(
+    result_.ambiguous = true;
+    result_.ambiguity_reason = fmt::format(
         "the evidence disagrees: the best supported pose lies {:.0f} % on the target surface, a runner-up nearly as "
         "well supported {:.0f} %: the scene may repeat; see the hypotheses",
         100 * best.surface_agreement, 100 * verdict.disputed_by);
   }
+}
 
-  result.transform = to_file_frames(local, source.origin_m, target.origin_m);
+// The pose, the hypotheses, their bases and the keypoints 4PCS matched, in the files' frames.
+void ScalePipeline::to_files_frames(const Eigen::Matrix4d& local, const CoarseAlignment& chosen) {
+  const Eigen::Vector3d &source_origin = source_scan_.cloud().origin_m, &target_origin = target_scan_.cloud().origin_m;
+  result_.transform = to_file_frames(local, source_origin, target_origin);
   auto in_file_frame = [](std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& origin) {
     for (Eigen::Vector3d& p : points) p += origin;
   };
-  for (Hypothesis& h : result.hypotheses) {
-    h.transform = to_file_frames(h.transform, source.origin_m, target.origin_m);
-    in_file_frame(h.base_source_m, source.origin_m);
-    in_file_frame(h.base_target_m, target.origin_m);
+  for (Hypothesis& h : result_.hypotheses) {
+    h.transform = to_file_frames(h.transform, source_origin, target_origin);
+    in_file_frame(h.base_source_m, source_origin);
+    in_file_frame(h.base_target_m, target_origin);
   }
-  if (chosen->source_points)
-    for (const Eigen::Vector3f& p : *chosen->source_points)
-      result.source_keypoint_positions_m.push_back(p.cast<double>() + source.origin_m);
-  if (chosen->target_points)
-    for (const Eigen::Vector3f& p : *chosen->target_points)
-      result.target_keypoint_positions_m.push_back(p.cast<double>() + target.origin_m);
-  result.well_supported = on_the_surface && best.refined_score >= needed;
-  const bool supported = result.well_supported;
-  return {std::move(result), supported};
+  if (chosen.source_points)
+    for (const Eigen::Vector3f& p : *chosen.source_points)
+      result_.source_keypoint_positions_m.push_back(p.cast<double>() + source_origin);
+  if (chosen.target_points)
+    for (const Eigen::Vector3f& p : *chosen.target_points)
+      result_.target_keypoint_positions_m.push_back(p.cast<double>() + target_origin);
+}
+
+// The single-scale pipeline, steps 1-5: the pair searched at minimum scale sigma.
+ScaleAttempt register_at_scale(const PreparedScan& source, const PreparedScan& target, const RegistrationParams& params,
+                               double sigma, const CancellationToken* cancel, const ProgressCallback& progress) {
+  ScalePipeline pipeline(source, target, params, sigma, cancel, progress);
+  return pipeline.refine(pipeline.search());
+}
+
+// Given poses (files' frames) judged at minimum scale sigma: the symmetry guard and the verdict rank them instead
+// of what 4PCS would find.
+ScaleAttempt judge_at_scale(const PreparedScan& source, const PreparedScan& target, const RegistrationParams& params,
+                            double sigma, const std::vector<Eigen::Matrix4d>& poses, const CancellationToken* cancel,
+                            const ProgressCallback& progress) {
+  ScalePipeline pipeline(source, target, params, sigma, cancel, progress);
+  return pipeline.refine(pipeline.given(poses));
 }
 
 // The start: DoG scales run from sigma to 2^5 sigma, and at diameter / 128 the coarsest octave still sees a
@@ -624,7 +713,7 @@ std::optional<ScaleAttempt> from_the_other_side(const PreparedScan& source, cons
                                                 const CancellationToken* cancel, const ProgressCallback& progress) {
   std::optional<ScaleAttempt> swapped;
   try {
-    swapped = register_at_scale(target, source, params, sigma, {}, cancel, progress);
+    swapped = register_at_scale(target, source, params, sigma, cancel, progress);
   } catch (const Error& e) {
     if (e.code() != ErrorCode::kFailedPrecondition) throw;
     return std::nullopt;
@@ -636,7 +725,7 @@ std::optional<ScaleAttempt> from_the_other_side(const PreparedScan& source, cons
   for (const Hypothesis& h : forward.hypotheses) poses.push_back(h.transform);
   RegistrationParams judging = params;
   judging.overlap = found.overlap_used;
-  ScaleAttempt judged = register_at_scale(source, target, judging, sigma, poses, cancel, progress);
+  ScaleAttempt judged = judge_at_scale(source, target, judging, sigma, poses, cancel, progress);
   add_timings(timings, judged.result.timings);
   if (!judged.supported) return std::nullopt;
   // What found the pose, told from this side.
@@ -660,7 +749,7 @@ RegistrationResult run(const PreparedScan& source, const PreparedScan& target, c
   for (double sigma = ladder.start_m(); sigma > 0.0; sigma = ladder.next(sigma, tried)) {
     ++tried;
     try {
-      ScaleAttempt attempt = register_at_scale(source, target, params, sigma, {}, cancel, progress);
+      ScaleAttempt attempt = register_at_scale(source, target, params, sigma, cancel, progress);
       add_timings(timings, attempt.result.timings);
       if (!attempt.supported && params.search_other_side)
         if (std::optional<ScaleAttempt> other =
@@ -710,7 +799,7 @@ RegistrationResult judge_poses(const PreparedScan& source, const PreparedScan& t
   RegistrationResult result;
   arena.execute([&] {
     const double sigma = ScaleLadder(source, target, params.min_scale_m).start_m();
-    result = register_at_scale(source, target, params, sigma, poses, cancel, {}).result;
+    result = judge_at_scale(source, target, params, sigma, poses, cancel, {}).result;
   });
   return result;
 }

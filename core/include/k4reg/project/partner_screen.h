@@ -39,7 +39,7 @@ std::vector<double> estimate_overlaps(const std::vector<PreparedScan>& scans, co
 std::vector<ScanPair> best_partners(std::size_t scans, const std::vector<double>& estimates, std::size_t partners);
 
 // For each scan in `extend`: its next `partners` best-estimated partners that `chosen` does not pair it with yet.
-// For scans whose first partners left them in no closed loop (project_registration.cpp registers these too, once).
+// For scans whose first partners left them in no closed loop (pair_stage.cpp registers these too, once).
 // Each pair once (low index first), sorted; none already in `chosen`.
 std::vector<ScanPair> more_partners(std::size_t scans, const std::vector<double>& estimates,
                                     const std::vector<ScanPair>& chosen, const std::vector<std::size_t>& extend,
