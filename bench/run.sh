@@ -2,14 +2,16 @@
 # bench/run.sh [--quick] [--table2] [--resume | --progress]
 # Builds the benchmarks, runs the voxel grid benchmark (Google Benchmark, 5 repetitions, medians), the read
 # throughput of every scan format (k4reg-bench-read, 10 M points, about half a minute) and the K-4PCS / 4PCS
-# comparison with PCL 1.13, then rewrites the machine, voxel, read and compare blocks of bench/RESULTS.md and the
-# files in bench/results/ (CSV, JSON, gnuplot scripts, PNG plots, run log). The full run then also measures the
-# paper's Table 2 for our K-4PCS (k4reg-bench-table2: its table2 block and results/table2-*.csv).
+# comparison with PCL 1.13, then rewrites the machine, voxel and read blocks of bench/RESULTS.md, the compare-<mode>
+# block of bench/results/comparison-with-pcl.md and the files in bench/results/ (CSV, JSON, gnuplot scripts, PNG
+# plots, run log). The full run then also measures the paper's Table 2 for our K-4PCS (k4reg-bench-table2: its
+# table2 block of bench/RESULTS.md and results/table2-*.csv).
 # --quick: a representative subset (about 20 min on 2 cores; Table 2 is left out to stay within that).
 #   Without it: the full suites (hours).
 # --resume: continue an interrupted comparison from its journal (bench/results/compare-<mode>-journal.jsonl):
 #   the runs already made are kept, only the missing ones run (same build and options).
-# --progress: while a comparison runs (or after it was interrupted), write its compare block, CSVs and plots
+# --progress: while a comparison runs (or after it was interrupted), write its compare block (in
+#   bench/results/comparison-with-pcl.md), CSVs and plots
 #   from the journal so far and run nothing; partial rows are marked.
 # --table2: only k4reg-bench-table2: with --quick its 0.7M, sigma = 50 mm row (all 15 pairs x 10 seeds, about
 #   3 min on 2 cores), without it the full grid of 3 sizes x 3 sigmas (about an hour on 2 cores).
@@ -34,6 +36,7 @@ done
 build=${K4REG_BENCH_BUILD_DIR:-build-bench}
 results=bench/results
 markdown=bench/RESULTS.md
+comparison=bench/results/comparison-with-pcl.md   # the compare-<mode> blocks (k4reg-bench-compare's own default is $markdown)
 mkdir -p "$results"
 
 # Replaces the lines between "<!-- NAME:begin -->" and "<!-- NAME:end -->" of FILE by CONTENT_FILE
@@ -75,7 +78,7 @@ plots() {
 }
 if $progress; then
   "$compare" "${quick_flag[@]}" --resume --report-only --cache-dir "$build/bench-cache" --results-dir "$results" \
-    --markdown "$markdown"
+    --markdown "$comparison"
   plots
   exit 0
 fi
@@ -120,8 +123,8 @@ replace_block "$markdown" read "$read_table"
 "$compare" voxel-report --json "$results/voxel_grid_bench.json" --markdown "$markdown" > /dev/null
 
 "$compare" "${quick_flag[@]}" "${resume_flag[@]}" --cache-dir "$build/bench-cache" --results-dir "$results" \
-  --markdown "$markdown" 2>&1 | tee ${resume_flag:+-a} "$results/compare-$mode.log"
+  --markdown "$comparison" 2>&1 | tee ${resume_flag:+-a} "$results/compare-$mode.log"
 
 plots
 if [[ $mode == full ]]; then table2; fi
-echo "bench/run.sh: done ($mode); see $markdown and $results/"
+echo "bench/run.sh: done ($mode); see $markdown, $comparison and $results/"
