@@ -52,7 +52,7 @@ void run_align_project(AlignProjectOptions& o) {
       clouds, o.params, nullptr, {}, [&](const ProjectLink& link, std::size_t index, std::size_t pairs) {
         if (o.flags.quiet) return;
         std::cerr << pair_line(index, pairs, link.source, link.target, link.seconds,
-                               link.verdict == "failed" ? link.reason : "")
+                               link.verdict == LinkVerdict::kFailed ? link.reason : "")
                   << "\n";
       });
   const nlohmann::json json = project_to_json(result, origins, o.params);

@@ -35,7 +35,7 @@ ProjectResult project_result_from_proto(const v1::ProjectResult& m) {
     link.ambiguous = l.ambiguous();
     link.well_supported = l.well_supported();
     link.accepted = l.accepted();
-    link.verdict = l.verdict();
+    link.verdict = link_verdict_from_string(l.verdict());
     link.reason = l.reason();
     link.loops = l.loops();
     link.loops_closed = l.loops_closed();

@@ -49,7 +49,7 @@ nlohmann::json project_to_json(const ProjectResult& r, const std::vector<ScanOri
                           {"ambiguous", l.ambiguous},
                           {"well_supported", l.well_supported},
                           {"accepted", l.accepted},
-                          {"verdict", l.verdict},
+                          {"verdict", to_string(l.verdict)},
                           {"reason", l.reason},
                           {"loops", l.loops},
                           {"loops_closed", l.loops_closed},

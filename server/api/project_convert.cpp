@@ -55,7 +55,7 @@ void project_result_to_proto(const ProjectResult& r, const std::vector<std::stri
     out.set_ambiguous(l.ambiguous);
     out.set_well_supported(l.well_supported);
     out.set_accepted(l.accepted);
-    out.set_verdict(l.verdict);
+    out.set_verdict(to_string(l.verdict));
     out.set_reason(l.reason);
     out.set_loops(l.loops);
     out.set_loops_closed(l.loops_closed);
@@ -94,7 +94,7 @@ void pair_event_to_proto(const ProjectLink& link, std::size_t index, std::size_t
   event.set_source(static_cast<std::uint32_t>(link.source));
   event.set_target(static_cast<std::uint32_t>(link.target));
   event.set_seconds(link.seconds);
-  if (link.verdict == "failed") event.set_error(link.reason);
+  if (link.verdict == LinkVerdict::kFailed) event.set_error(link.reason);
 }
 
 }  // namespace k4reg::service

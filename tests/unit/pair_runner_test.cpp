@@ -73,10 +73,10 @@ TEST_F(PairRunnerTest, APairTheRunnerCannotRegisterIsAFailedLink) {
   ReversedConcurrentRunner runner;
   runner.failing = 0;
   const ProjectResult result = register_project(scans, params, nullptr, {}, {}, &runner);
-  EXPECT_EQ(result.links[0].verdict, "failed");
+  EXPECT_EQ(result.links[0].verdict, LinkVerdict::kFailed);
   EXPECT_NE(result.links[0].reason.find("peer gone"), std::string::npos);
   EXPECT_FALSE(result.links[0].accepted);
-  EXPECT_NE(result.links[1].verdict, "failed");
+  EXPECT_NE(result.links[1].verdict, LinkVerdict::kFailed);
 }
 
 TEST_F(PairRunnerTest, CancellationStopsTheLocalRunner) {

@@ -157,7 +157,7 @@ TEST(ProjectRegistration, ScreenedLinkInNoLoopIsAcceptedWhereTheScreenLeftNoPair
   const ProjectResult r = register_project({bunny.scans[0], bunny.scans[1]}, params);
   ASSERT_EQ(r.links.size(), 1u);
   EXPECT_TRUE(r.links[0].accepted) << r.links[0].reason;
-  EXPECT_EQ(r.links[0].verdict, "unchecked");
+  EXPECT_EQ(r.links[0].verdict, LinkVerdict::kUnchecked);
   EXPECT_TRUE(r.scans[1].registered) << r.scans[1].reason;
   EXPECT_LT(rms_error_m(bunny.scans[1], r.scans[1].pose, bunny.truth[1]), 0.001);
 }

@@ -24,7 +24,7 @@ ProjectResult placed_project() {
     link.source = s, link.target = t, link.accepted = accepted;
     link.transform = rigid_inverse(r.scans[t].pose) * r.scans[s].pose;
     link.well_supported = true;
-    link.verdict = accepted ? "confirmed" : "contradicted";
+    link.verdict = accepted ? LinkVerdict::kConfirmed : LinkVerdict::kContradicted;
     link.min_scale_m_used = 0.05;  // tolerance 3 x 0.1 m
     r.links.push_back(link);
   }

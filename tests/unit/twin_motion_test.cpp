@@ -44,16 +44,16 @@ struct HallProject {
     // Station 0's links: pairwise margins 0.020, 0.013, 0.017, each over another half turn; reverse margins as
     // measured. Per link the cut adds 0.049; moved as one, the scans lose at least 0.0587 (the vertical half turn).
     const double close = floor_on_ceiling_close ? 0.001 : 0.0;
-    add({0, 1}, {0.9799, close > 0 ? 1.0 - close : 0.9663, 0.9705}, 1.0, 0.0014, "consistent");
-    add({0, 2}, {0.9770, close > 0 ? 1.0 - close : 0.9866, 0.9711}, 1.0, 0.0, "consistent");
-    add({0, 3}, {0.9795, close > 0 ? 0.9965 - close : 0.9791, 0.9644}, 0.9965, -0.0029, "consistent");
-    add({1, 2}, {0.9799, 0.9747, 0.9713}, 0.9997, 0.0248, "confirmed");
-    add({1, 3}, {0.9790, 0.9646, 0.9926}, 0.9988, 0.0241, "confirmed");
-    add({2, 3}, {0.9721, 0.9662, 0.9662}, 0.9986, 0.0106, "confirmed");
+    add({0, 1}, {0.9799, close > 0 ? 1.0 - close : 0.9663, 0.9705}, 1.0, 0.0014, LinkVerdict::kConsistent);
+    add({0, 2}, {0.9770, close > 0 ? 1.0 - close : 0.9866, 0.9711}, 1.0, 0.0, LinkVerdict::kConsistent);
+    add({0, 3}, {0.9795, close > 0 ? 0.9965 - close : 0.9791, 0.9644}, 0.9965, -0.0029, LinkVerdict::kConsistent);
+    add({1, 2}, {0.9799, 0.9747, 0.9713}, 0.9997, 0.0248, LinkVerdict::kConfirmed);
+    add({1, 3}, {0.9790, 0.9646, 0.9926}, 0.9988, 0.0241, LinkVerdict::kConfirmed);
+    add({2, 3}, {0.9721, 0.9662, 0.9662}, 0.9986, 0.0106, LinkVerdict::kConfirmed);
   }
   // A link with the truth and the source moved by each half turn (vertical, along y, along x), scored so.
   void add(std::pair<std::size_t, std::size_t> scans, std::array<double, 3> twin_scores, double truth_score,
-           double reverse_margin, const std::string& verdict) {
+           double reverse_margin, LinkVerdict verdict) {
     const auto [s, t] = scans;
     LinkCandidates c{s, t, {}, 0.1, true, 0.0, true, {}};
     const Eigen::Matrix4d to_target = rigid_inverse(project.scans[t].pose);
@@ -115,7 +115,7 @@ TEST(TwinMotion, NoLinkWithAnotherCandidateLeavesThePerLinkCutAndNoTwin) {
   HallProject hall;
   for (LinkCandidates& c : hall.candidates) c.transforms.resize(1), c.scores.resize(1);
   for (ProjectLink& link : hall.project.links) link.ambiguity_margin = 0.01, link.reverse_judged = false;
-  for (std::size_t l : {3, 4, 5}) hall.project.links[l].verdict = "confirmed";
+  for (std::size_t l : {3, 4, 5}) hall.project.links[l].verdict = LinkVerdict::kConfirmed;
   const std::vector<TwinHold> holds =
       holds_against_twins(hall.project, hall.candidates, hall.all_links(), hall.radius_m, 1.0);
   for (std::size_t i : {1, 2, 3}) {

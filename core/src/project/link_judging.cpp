@@ -43,7 +43,9 @@ std::string selection_reason(const LinkSelection& s, const LinkCandidates& candi
       return s.loops == 0 ? "ambiguous pairwise result in no loop that could resolve it"
                           : fmt::format("ambiguous pairwise result whose {} loops do not all close, and none vouches for it",
                                         s.loops);
-    case LinkVerdict::kFailed: break;
+    case LinkVerdict::kFailed:
+    case LinkVerdict::kInconsistent:
+    case LinkVerdict::kPending: break;  // reasons set where they arise
   }
   return {};
 }
@@ -126,7 +128,7 @@ void select_links(const std::vector<LinkCandidates>& candidates, const std::vect
     link.loops_closed = s.loops_closed;
     link.loop_residual_m = s.loop_residual_m;
     if (candidates[l].transforms.empty()) continue;  // failed, reason set
-    link.verdict = to_string(s.verdict);
+    link.verdict = s.verdict;
     link.candidate = s.candidate;
     // With screened pairs a link in no loop may owe that to the screen, not to the scene: where its scans' other
     // partners were not all registered, nothing checked it, so it is not taken on its pairwise verdict alone.

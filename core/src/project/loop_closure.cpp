@@ -123,18 +123,6 @@ LoopPoseJudgement judge_implied_poses(const LinkCandidates& link, const std::vec
   return tied ? LoopPoseJudgement::kTied : LoopPoseJudgement::kWinnerStands;
 }
 
-const char* to_string(LinkVerdict verdict) {
-  switch (verdict) {
-    case LinkVerdict::kConfirmed: return "confirmed";
-    case LinkVerdict::kConsistent: return "consistent";
-    case LinkVerdict::kUnchecked: return "unchecked";
-    case LinkVerdict::kContradicted: return "contradicted";
-    case LinkVerdict::kUnresolved: return "unresolved";
-    case LinkVerdict::kFailed: return "failed";
-  }
-  return "?";
-}
-
 LoopSelectionResult select_loop_consistent(const std::vector<LinkCandidates>& links,
                                            const std::vector<ScanExtent>& extents) {
   const std::vector<Triangle> triangles = find_triangles(links);

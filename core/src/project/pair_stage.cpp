@@ -142,7 +142,7 @@ LinkCandidates link_from_outcome(const PairOutcome& outcome, const ScanPair& pai
   link.seconds = outcome.seconds;
   LinkCandidates c{s, t, {}, 0.0, false, 0.0, false, {}};
   if (!outcome.result) {
-    link.verdict = "failed";
+    link.verdict = LinkVerdict::kFailed;
     link.reason = outcome.error ? outcome.error->what() : "not registered";
     return c;
   }

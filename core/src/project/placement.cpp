@@ -73,7 +73,7 @@ void place_scans(ProjectResult& r, const std::vector<ScanExtent>& extents) {
 void reject(ProjectResult& r, std::size_t l, const std::string& reason) {
   ProjectLink& link = r.links[l];
   link.accepted = false;
-  link.verdict = "inconsistent";
+  link.verdict = LinkVerdict::kInconsistent;
   link.reason = reason;
   for (ProjectScan& scan : r.scans) std::erase(scan.links, l);
 }

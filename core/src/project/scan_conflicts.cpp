@@ -15,7 +15,7 @@ void refuse_conflicted_scans(ProjectResult& r, const std::vector<ScanExtent>& ex
     if (link.accepted) ++holding[link.source], ++holding[link.target];
   for (std::size_t l = 0; l < r.links.size(); ++l) {
     const ProjectLink& link = r.links[l];
-    if (link.accepted || link.verdict == "failed" || link.ambiguous || !link.well_supported) continue;
+    if (link.accepted || link.verdict == LinkVerdict::kFailed || link.ambiguous || !link.well_supported) continue;
     if (!r.scans[link.source].registered || !r.scans[link.target].registered) continue;
     const double misfit = displacement_m(link_misfit(r.scans[link.source].pose, r.scans[link.target].pose, link.transform),
                                          extents.at(link.source));

@@ -23,7 +23,7 @@ double forward_margin(const ProjectLink& link, const LinkCandidates& c) {
 double weight_with(const ProjectLink& link, double forward) {
   const double margin = link.reverse_judged ? std::max(forward + link.reverse_margin, 0.0) : forward;
   const double weight = holds_anything(link) ? margin : 0.0;
-  return link.verdict == "confirmed" ? std::max(weight, kAmbiguousMargin) : weight;
+  return link.verdict == LinkVerdict::kConfirmed ? std::max(weight, kAmbiguousMargin) : weight;
 }
 
 // The link's transform once the scans on one side move by `motion`: its source's side, or its target's.

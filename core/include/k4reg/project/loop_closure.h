@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "k4reg/geometry/rigid_motion.h"
+#include "k4reg/project/project_types.h"
 #include "k4reg/registration/registration.h"
 
 namespace k4reg {
@@ -39,15 +40,6 @@ struct LinkCandidates {
                                 // margins made from its scores count as margin_against_free_space_bar says
 };
 
-enum class LinkVerdict {
-  kConfirmed,     // its chosen candidate closes at least one loop
-  kConsistent,    // closes all its loops, though none vouches for it (a symmetric scene): accepted, and
-                  // how firmly it holds its scans is left to scan_strength.h
-  kUnchecked,     // in no loop; accepted on its pairwise verdict (unambiguous)
-  kContradicted,  // closes no vouching loop, and an open loop blames it: rejected
-  kUnresolved,    // ambiguous pairwise, and no loop resolves it (in none, or its loops stay open unblamed): rejected
-  kFailed,        // pairwise registration found no candidate
-};
 
 struct LinkSelection {
   int candidate = -1;         // index into transforms; -1 when rejected or failed
@@ -96,7 +88,5 @@ bool within_loop_tolerance(const LinkCandidates& link, const Eigen::Matrix4d& a,
 enum class LoopPoseJudgement { kWinnerStands, kImpliedWon, kTied };
 LoopPoseJudgement judge_implied_poses(const LinkCandidates& link, const std::vector<Eigen::Matrix4d>& implied,
                                       const RegistrationResult& judged, const std::vector<ScanExtent>& extents);
-
-const char* to_string(LinkVerdict verdict);
 
 }  // namespace k4reg

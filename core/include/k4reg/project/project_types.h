@@ -17,6 +17,26 @@
 
 namespace k4reg {
 
+// What the loops, the placement and the refinement made of a link.
+enum class LinkVerdict {
+  kConfirmed,     // its chosen candidate closes at least one loop
+  kConsistent,    // closes all its loops, though none vouches for it (a symmetric scene): accepted, and
+                  // how firmly it holds its scans is left to scan_strength.h
+  kUnchecked,     // in no loop; accepted on its pairwise verdict (unambiguous)
+  kContradicted,  // closes no vouching loop, and an open loop blames it: rejected
+  kUnresolved,    // ambiguous pairwise, and no loop resolves it (in none, or its loops stay open unblamed): rejected
+  kFailed,        // pairwise registration found no candidate
+  kInconsistent,  // accepted by its loops, then contradicted by the placement or the refined project: rejected
+  kPending,       // registered, not judged yet (a link as a pair finishes, before the loops)
+};
+
+// Its name in the API (proto, JSON): confirmed, consistent, unchecked, contradicted, unresolved, failed, inconsistent,
+// pending.
+const char* to_string(LinkVerdict verdict);
+
+// The verdict of an API name; kInvalidArgument for another.
+LinkVerdict link_verdict_from_string(const std::string& name);
+
 struct ProjectParams {
   // Per pair as in register_clouds: min_scale_m and overlap 0 = automatic (the defaults), seed, threads, ...
   // Every pair runs with this seed, so a link equals `k4reg align` on the same two scans.
@@ -51,7 +71,7 @@ struct ProjectLink {
   double reverse_margin = 0.0, two_sided_margin = 0.0;
   int candidate = -1;          // the one chosen (0 = the pairwise winner, or the runner-up both sides preferred), -1 = none
   bool accepted = false;
-  std::string verdict;  // confirmed, unchecked, contradicted, unresolved, failed, inconsistent
+  LinkVerdict verdict = LinkVerdict::kPending;
   std::string reason;   // why not accepted (or how it was accepted), in words
   int loops = 0, loops_closed = 0;
   double loop_residual_m = -1.0;  // smallest residual of its loops (m); -1 = in no loop
