@@ -11,6 +11,7 @@
 #include "k4reg/io/gt_pairs.h"
 #include "k4reg/geometry/voxel_grid.h"
 #include "k4reg/registration/prepared_scan.h"
+#include "k4reg/registration/registration.h"
 
 namespace k4reg {
 namespace {

@@ -12,7 +12,8 @@ namespace {
 // The scans that no loop of the pairs registered so far confirms (a first loop selection, milliseconds).
 std::vector<std::size_t> unconfirmed_scans(std::size_t scans, const RegisteredPairs& registered,
                                            const std::vector<ScanExtent>& extents) {
-  const auto& [pairs, outcomes] = registered;
+  const std::vector<ScanPair>& pairs = registered.pairs;
+  const std::vector<PairOutcome>& outcomes = registered.outcomes;
   std::vector<LinkCandidates> found;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     ProjectLink scratch;
@@ -35,7 +36,8 @@ class PairRegistrar {
       : in_(in), on_pair_(on_pair), runner_(runner) {}
 
   void register_new(RegisteredPairs& registered) {
-    auto& [pairs, outcomes] = registered;
+    std::vector<ScanPair>& pairs = registered.pairs;
+    std::vector<PairOutcome>& outcomes = registered.outcomes;
     const std::size_t first = outcomes.size();
     const std::vector<ScanPair> batch(pairs.begin() + static_cast<std::ptrdiff_t>(first), pairs.end());
     outcomes.resize(pairs.size());
@@ -64,7 +66,8 @@ class PairRegistrar {
 // added to `timings`.
 void search_unconfirmed_from_the_other_side(const ProjectInputs& in, PairRegistrar& registrar,
                                             RegisteredPairs& registered, std::vector<StageTiming>& timings) {
-  auto& [pairs, outcomes] = registered;
+  std::vector<ScanPair>& pairs = registered.pairs;
+  std::vector<PairOutcome>& outcomes = registered.outcomes;
   const std::vector<std::size_t> unconfirmed = unconfirmed_scans(in.scans.size(), registered, in.extents);
   auto doubtful = [&](std::size_t i) { return std::binary_search(unconfirmed.begin(), unconfirmed.end(), i); };
   std::vector<std::size_t> again;

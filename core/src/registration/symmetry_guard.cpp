@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "k4reg/registration/ambiguity_margin.h"
 #include "k4reg/registration/four_pcs.h"
 #include "k4reg/registration/icp.h"
 #include "k4reg/geometry/neighbor_grid.h"

@@ -1,15 +1,16 @@
 // The margin a verdict needs between its best pose and the runner-up, by the evidence it rests on.
 // With the scanners' free space (or the cameras' views), a true pose explains 0.95-1.00 of what the target saw and
-// a twin clearly less, so kAmbiguousMargin (registration.h) separates them. On geometry alone (clouds with no known
+// a twin clearly less, so kAmbiguousMargin separates them. On geometry alone (clouds with no known
 // scanner: merged, resampled, multi-beam; or --free-space off) a symmetric room's half-turn twin can explain more
 // of the source than the truth does: on the blind protocol's tuning pairs with free space off, wrong poses won by
 // margins up to 0.16 (held out: 0.13), right ones by 0.05 to 0.5. There a runner-up anywhere in the contender
 // band (within a fifth of the best's support, the hypotheses the verdict refines) leaves the result ambiguous.
 #pragma once
 
-#include "k4reg/registration/registration.h"
-
 namespace k4reg {
+
+// Below this margin between the best pose and the runner-up, a result judged with free space is flagged ambiguous.
+constexpr double kAmbiguousMargin = 0.05;
 
 constexpr double kGeometryOnlyAmbiguousMargin = 0.2;
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "k4reg/util/cancellation.h"
-#include "k4reg/registration/registration.h"
+#include "k4reg/registration/hypothesis.h"
 
 namespace k4reg {
 

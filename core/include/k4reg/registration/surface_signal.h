@@ -9,7 +9,7 @@
 
 #include "k4reg/util/cancellation.h"
 #include "k4reg/geometry/point_cloud.h"
-#include "k4reg/registration/registration.h"
+#include "k4reg/registration/registration_params.h"
 
 namespace k4reg {
 

@@ -21,7 +21,7 @@
 #include "k4reg/registration/icp.h"
 #include "k4reg/geometry/neighbor_grid.h"
 #include "k4reg/geometry/point_cloud.h"
-#include "k4reg/registration/registration.h"
+#include "k4reg/registration/hypothesis.h"
 
 namespace k4reg {
 
