@@ -351,10 +351,8 @@ ScannerEstimate estimate_scanner_position(const NeighbourAngles& angles, const C
 }
 
 namespace {
-constexpr double kMinScannerRange = 1.0;  // a terrestrial scanner's median range, at least
-}  // namespace
 
-namespace {
+constexpr double kMinScannerRange = 1.0;  // a terrestrial scanner's median range, at least
 
 Eigen::AlignedBox3f bounds(const std::vector<Eigen::Vector3f>& points) {
   Eigen::AlignedBox3f box;
