@@ -137,15 +137,14 @@ void decorate_reply(const ServiceContext& service, const CallClock& clock, const
   reply.set_request_id(request_id);
 }
 
-grpc::Status run_job(const ServiceContext& service, Job& job, const CloudSource& source, const CloudSource& target,
-                     const RegistrationParams& params, std::size_t preview_points, const StageListener& listener,
+grpc::Status run_job(const ServiceContext& service, Job& job, const PairJob& pair, const StageListener& listener,
                      CallClock& clock, RequestRecord& record, v1::RegisterResponse& reply) {
   clock.job_start = CallClock::Clock::now();
   JobReport report;
   grpc::Status status;
   try {
-    const RegistrationOutcome outcome = run_registration(source, target, params, preview_points, service.limits,
-                                                         service.memory, job.token(), listener, report);
+    const RegistrationOutcome outcome =
+        run_registration(pair, service.limits, service.memory, job.token(), listener, report);
     result_to_proto(outcome.result, reply.mutable_result());
     if (outcome.preview) preview_to_proto(*outcome.preview, reply.mutable_preview());
   } catch (...) {

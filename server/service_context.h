@@ -104,9 +104,8 @@ void decorate_reply(const ServiceContext& service, const CallClock& clock, const
 
 // The worker's side of a call, the same for both RPCs and HTTP: runs the registration, times it on `clock`,
 // notes points and times in `record` and the metrics, and on success fills and decorates `reply`. Returns
-// the call's status. preview_points > 0 adds a preview of that many points to the reply.
-grpc::Status run_job(const ServiceContext& service, Job& job, const CloudSource& source, const CloudSource& target,
-                     const RegistrationParams& params, std::size_t preview_points, const StageListener& listener,
+// the call's status.
+grpc::Status run_job(const ServiceContext& service, Job& job, const PairJob& pair, const StageListener& listener,
                      CallClock& clock, RequestRecord& record, v1::RegisterResponse& reply);
 
 }  // namespace k4reg::service

@@ -93,27 +93,25 @@ void handle_register(const ServiceContext& service, HttpExchange& exchange) {
   struct Call {
     v1::RegisterRequest request;  // owns inline cloud bytes
     UploadForm form;              // owns spool files
-    RegistrationParams params;
-    CloudSource source, target;
-    std::size_t preview_points = 0;
+    PairJob pair;
   };
   auto call = std::make_shared<Call>();
   CallClock clock;
   try {
     if (body_kind(exchange.request) == BodyKind::kJson) {
       from_json(exchange.body.read_all(json_body_limit(service)), call->request);
-      call->params = params_from_proto(call->request.params());
-      call->preview_points = preview_points_from_proto(call->request.preview_points());
-      call->source = service.cloud_source(call->request.source(), "source");
-      call->target = service.cloud_source(call->request.target(), "target");
+      call->pair.params = params_from_proto(call->request.params());
+      call->pair.preview_points = preview_points_from_proto(call->request.preview_points());
+      call->pair.source = service.cloud_source(call->request.source(), "source");
+      call->pair.target = service.cloud_source(call->request.target(), "target");
     } else {
       clock.upload_start = CallClock::Clock::now();
       call->form = read_upload_form(exchange.body, service, FormKind::kPair);
       clock.upload_end = CallClock::Clock::now();
-      call->params = params_from_proto(call->form.params.pairwise());
-      call->preview_points = preview_points_from_proto(call->form.preview_points);
-      call->source = call->form.clouds[0];
-      call->target = call->form.clouds[1];
+      call->pair.params = params_from_proto(call->form.params.pairwise());
+      call->pair.preview_points = preview_points_from_proto(call->form.preview_points);
+      call->pair.source = call->form.clouds[0];
+      call->pair.target = call->form.clouds[1];
     }
   } catch (...) {
     exchange.fail(status_from_current_exception());
@@ -125,8 +123,8 @@ void handle_register(const ServiceContext& service, HttpExchange& exchange) {
         events.post_stage<v1::RegisterStreamResponse>(stage, phase, fraction);
       };
       v1::RegisterStreamResponse reply;
-      const grpc::Status status = run_job(service, job, call->source, call->target, call->params, call->preview_points,
-                                          listener, events.clock, events.record, *reply.mutable_result());
+      const grpc::Status status =
+          run_job(service, job, call->pair, listener, events.clock, events.record, *reply.mutable_result());
       if (status.ok()) events.post(reply);
       return status;
     });
@@ -135,11 +133,7 @@ void handle_register(const ServiceContext& service, HttpExchange& exchange) {
   v1::RegisterResponse reply;
   bool queue_full = false;
   const grpc::Status status = run_and_wait(
-      service, clock,
-      [&](Job& job) {
-        return run_job(service, job, call->source, call->target, call->params, call->preview_points, {}, clock,
-                       exchange.record, reply);
-      },
+      service, clock, [&](Job& job) { return run_job(service, job, call->pair, {}, clock, exchange.record, reply); },
       queue_full);
   if (!status.ok()) {
     exchange.fail(status, queue_full);

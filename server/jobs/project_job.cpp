@@ -18,10 +18,10 @@ namespace {
 
 }  // namespace
 
-ProjectOutcome run_project(const std::vector<CloudSource>& scans, const std::vector<std::string>& names,
-                           ProjectParams params, std::size_t preview_points, const JobLimits& limits,
-                           MemoryBudget& memory, const CancellationToken& token, const StageListener& stages,
-                           const PairListener& pairs, PairRunner* runner, ProjectReport& report) {
+ProjectOutcome run_project(const ProjectJob& project, const JobLimits& limits, MemoryBudget& memory,
+                           const CancellationToken& token, const StageListener& stages, const PairListener& pairs,
+                           PairRunner* runner, ProjectReport& report) {
+  const std::vector<CloudSource>& scans = project.scans;
   token.throw_if_stopped();  // cancelled or expired while queued
   StageTracker progress(stages);
   const auto load_start = SteadyClock::now();
@@ -48,13 +48,14 @@ ProjectOutcome run_project(const std::vector<CloudSource>& scans, const std::vec
   progress("load", 1.0);
   report.load_s = seconds_since(load_start);
 
+  ProjectParams params = project.params;
   if (params.pairwise.threads == 0 || params.pairwise.threads > limits.job_threads) params.pairwise.threads = limits.job_threads;
   const auto start = SteadyClock::now();
   const ProgressCallback callback = [&](const std::string& stage, double fraction) { progress(stage, fraction); };
   ProjectOutcome outcome{register_project(clouds, params, &token, callback, pairs, runner), std::nullopt};
   report.registration_s = seconds_since(start);
-  outcome.preview = preview_stage(preview_points, progress, [&](const PreviewParams& preview) {
-    return make_project_preview(clouds, names, outcome.result, preview, &token);
+  outcome.preview = preview_stage(project.preview_points, progress, [&](const PreviewParams& preview) {
+    return make_project_preview(clouds, project.names, outcome.result, preview, &token);
   });
   return outcome;
 }
@@ -99,9 +100,8 @@ grpc::Status run_project_job(const ServiceContext& service, Job& job, const Proj
     if (service.peers)
       runner.emplace(service.peers, service.peer_options, PeerCaller{record.request_id, service.pair_token()},
                      service.metrics, placement);
-    const ProjectOutcome outcome =
-        run_project(project.scans, project.names, project.params, project.preview_points, service.limits,
-                    service.memory, job.token(), stages, pairs, runner ? &*runner : nullptr, report);
+    const ProjectOutcome outcome = run_project(project, service.limits, service.memory, job.token(), stages, pairs,
+                                               runner ? &*runner : nullptr, report);
     if (!runner) placement.local = outcome.result.links.size();  // one link per pair
     project_result_to_proto(outcome.result, project.names, reply.mutable_result());
     if (outcome.preview) preview_to_proto(*outcome.preview, reply.mutable_preview());

@@ -27,14 +27,6 @@ struct ProjectOutcome {
   std::optional<CloudPreview> preview;
 };
 
-// Throws k4reg::Error: the first scan that cannot be read (named as the client named it), kInvalidArgument
-// for a malformed project (fewer than 2 scans, a reference out of range, ...), kResourceExhausted over the
-// memory budget, kCancelled / kDeadlineExceeded once the token fires. The preview is the last stage.
-ProjectOutcome run_project(const std::vector<CloudSource>& scans, const std::vector<std::string>& names,
-                           ProjectParams params, std::size_t preview_points, const JobLimits& limits,
-                           MemoryBudget& memory, const CancellationToken& token, const StageListener& stages,
-                           const PairListener& pairs, PairRunner* runner, ProjectReport& report);
-
 // A project request as the worker will run it: its scans (references resolved, inline bytes owned by the
 // request) and parameters. Throws k4reg::Error for fewer than 2 scans, a scan given twice by path, bad
 // parameters and the path errors of PathPolicy::resolve, so a malformed project is refused before it queues.
@@ -46,6 +38,13 @@ struct ProjectJob {
 };
 ProjectJob make_project_job(std::vector<CloudSource> scans, const v1::ProjectParams& params, std::uint32_t preview_points);
 ProjectJob project_job_from_proto(const ServiceContext& service, const v1::RegisterProjectRequest& request);
+
+// Throws k4reg::Error: the first scan that cannot be read (named as the client named it), kInvalidArgument
+// for a malformed project (fewer than 2 scans, a reference out of range, ...), kResourceExhausted over the
+// memory budget, kCancelled / kDeadlineExceeded once the token fires. The preview is the last stage.
+ProjectOutcome run_project(const ProjectJob& project, const JobLimits& limits, MemoryBudget& memory,
+                           const CancellationToken& token, const StageListener& stages, const PairListener& pairs,
+                           PairRunner* runner, ProjectReport& report);
 
 // The worker's side of a project call, the same for gRPC and HTTP (cf. run_job): runs it, times it on
 // `clock`, notes points and times in `record` and the metrics, and on success fills `reply`.

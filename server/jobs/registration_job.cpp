@@ -75,9 +75,9 @@ std::optional<CloudPreview> preview_stage(std::size_t preview_points, StageTrack
   return preview;
 }
 
-RegistrationOutcome run_registration(const CloudSource& source, const CloudSource& target, RegistrationParams params,
-                                     std::size_t preview_points, const JobLimits& limits, MemoryBudget& memory,
+RegistrationOutcome run_registration(const PairJob& pair, const JobLimits& limits, MemoryBudget& memory,
                                      const CancellationToken& token, const StageListener& listener, JobReport& report) {
+  const CloudSource &source = pair.source, &target = pair.target;
   token.throw_if_stopped();  // cancelled or expired while queued
   StageTracker progress(listener);
 
@@ -97,12 +97,13 @@ RegistrationOutcome run_registration(const CloudSource& source, const CloudSourc
   progress("load", 1.0);
   report.load_s = seconds_since(load_start);
 
+  RegistrationParams params = pair.params;
   if (params.threads == 0 || params.threads > limits.job_threads) params.threads = limits.job_threads;
   const auto start = SteadyClock::now();
   const ProgressCallback callback = [&](const std::string& stage, double fraction) { progress(stage, fraction); };
   RegistrationOutcome outcome{register_clouds(source_cloud, target_cloud, params, &token, callback), std::nullopt};
   report.registration_s = seconds_since(start);
-  outcome.preview = preview_stage(preview_points, progress, [&](const PreviewParams& preview) {
+  outcome.preview = preview_stage(pair.preview_points, progress, [&](const PreviewParams& preview) {
     return make_pair_preview(source_cloud, target_cloud, outcome.result, preview, &token);
   });
   return outcome;

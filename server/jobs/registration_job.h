@@ -75,10 +75,16 @@ struct RegistrationOutcome {
   std::optional<CloudPreview> preview;
 };
 
+// A pair call's inputs as the gRPC and HTTP front ends resolve them (cf. ProjectJob).
+struct PairJob {
+  CloudSource source, target;
+  RegistrationParams params;
+  std::size_t preview_points = 0;  // > 0: a preview of that many points comes back too
+};
+
 // Throws k4reg::Error (kCancelled / kDeadlineExceeded once the token fires). The preview is the last stage
 // ("preview").
-RegistrationOutcome run_registration(const CloudSource& source, const CloudSource& target, RegistrationParams params,
-                                     std::size_t preview_points, const JobLimits& limits, MemoryBudget& memory,
+RegistrationOutcome run_registration(const PairJob& pair, const JobLimits& limits, MemoryBudget& memory,
                                      const CancellationToken& token, const StageListener& listener, JobReport& report);
 
 }  // namespace k4reg::service

@@ -15,10 +15,10 @@ RegisterReactor::RegisterReactor(ServiceContext& service, grpc::CallbackServerCo
   }
   try {
     service_.check_inline_size(request->ByteSizeLong());
-    params_ = params_from_proto(request->params());
-    preview_points_ = preview_points_from_proto(request->preview_points());
-    source_ = service_.cloud_source(request->source(), "source");
-    target_ = service_.cloud_source(request->target(), "target");
+    pair_.params = params_from_proto(request->params());
+    pair_.preview_points = preview_points_from_proto(request->preview_points());
+    pair_.source = service_.cloud_source(request->source(), "source");
+    pair_.target = service_.cloud_source(request->target(), "target");
   } catch (...) {
     finish(status_from_current_exception());
     return;
@@ -31,9 +31,7 @@ RegisterReactor::RegisterReactor(ServiceContext& service, grpc::CallbackServerCo
   if (const grpc::Status status = service_.submit(job_, position); !status.ok()) finish(status);
 }
 
-void RegisterReactor::execute(Job& job) {
-  finish(run_job(service_, job, source_, target_, params_, preview_points_, {}, clock_, record_, *reply_));
-}
+void RegisterReactor::execute(Job& job) { finish(run_job(service_, job, pair_, {}, clock_, record_, *reply_)); }
 
 void RegisterReactor::OnCancel() {
   if (!job_) return;  // refused before queueing; already finished

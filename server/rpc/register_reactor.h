@@ -28,9 +28,7 @@ class RegisterReactor final : public grpc::ServerUnaryReactor {
   v1::RegisterResponse* reply_;
   RequestRecord record_;
   CallClock clock_;
-  RegistrationParams params_;
-  std::size_t preview_points_ = 0;
-  CloudSource source_, target_;
+  PairJob pair_;
   std::shared_ptr<Job> job_;
   std::atomic<bool> finished_{false};
 };

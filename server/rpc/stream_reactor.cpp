@@ -11,10 +11,10 @@ StreamReactor::StreamReactor(ServiceContext& service, grpc::CallbackServerContex
 
 void StreamReactor::on_header(const v1::RegisterStreamRequest& request) {
   const v1::UploadHeader& header = request.header();
-  params_ = params_from_proto(header.params());
-  preview_points_ = preview_points_from_proto(header.preview_points());
-  source_ = uploads_.add(header.source(), "source");
-  target_ = uploads_.add(header.target(), "target");
+  pair_.params = params_from_proto(header.params());
+  pair_.preview_points = preview_points_from_proto(header.preview_points());
+  pair_.source = uploads_.add(header.source(), "source");
+  pair_.target = uploads_.add(header.target(), "target");
 }
 
 void StreamReactor::on_chunk(const v1::RegisterStreamRequest& request) {
@@ -28,8 +28,7 @@ void StreamReactor::on_chunk(const v1::RegisterStreamRequest& request) {
 void StreamReactor::execute(Job& job) {
   v1::RegisterStreamResponse reply;
   const grpc::Status status =
-      run_job(service_, job, source_, target_, params_, preview_points_, stage_listener(clock_), clock_, record_,
-              *reply.mutable_result());
+      run_job(service_, job, pair_, stage_listener(clock_), clock_, record_, *reply.mutable_result());
   if (status.ok()) post(std::move(reply));
   finish(status);
 }

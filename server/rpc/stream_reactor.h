@@ -15,9 +15,7 @@ class StreamReactor final : public UploadStreamReactor<v1::RegisterStreamRequest
   void on_chunk(const v1::RegisterStreamRequest& request) override;
   void execute(Job& job) override;
 
-  RegistrationParams params_;
-  std::size_t preview_points_ = 0;
-  CloudSource source_, target_;
+  PairJob pair_;
 };
 
 }  // namespace k4reg::service

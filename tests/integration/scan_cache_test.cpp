@@ -25,7 +25,7 @@ PointCloud random_cloud(unsigned seed, std::size_t count = 20000) {
 void prepare(const ScanCache::Scan& scan) {
   IcpParams params;
   params.voxel_m = 0.02;
-  scan.prepared.pyramid(0.02, params, /*as_target=*/true, nullptr);
+  scan.prepared.pyramid(0.02, params, PyramidRole::kTarget, nullptr);
 }
 
 TEST(ScanCache, CountsWhatPairsPrepareOnAScan) {

@@ -60,8 +60,8 @@ TEST(Icp, BringsAMovedCornerBack) {
   const auto source_points = moved(corner(true, rng), truth.inverse());  // source = truth^-1 * target geometry
   IcpParams params;
   params.voxel_m = 0.02;
-  const IcpPyramid source = make_icp_pyramid(source_points, params, false);
-  const IcpPyramid target = make_icp_pyramid(target_points, params, true);
+  const IcpPyramid source = make_icp_pyramid(source_points, params, PyramidRole::kSource);
+  const IcpPyramid target = make_icp_pyramid(target_points, params, PyramidRole::kTarget);
   const IcpResult r = refine_icp(source, target, Eigen::Matrix4d::Identity(), params);
   EXPECT_TRUE(r.converged);
   const Eigen::Matrix4d error = truth.inverse() * r.transform;
@@ -85,8 +85,9 @@ TEST(Icp, ConvergesAlikeFarFromTheFramesOrigin) {
   IcpParams params;
   params.voxel_m = 0.02;
   auto run = [&](const Eigen::Matrix4d& placement) {
-    return refine_icp(make_icp_pyramid(moved(source_points, placement), params, false),
-                      make_icp_pyramid(moved(target_points, placement), params, true), Eigen::Matrix4d::Identity(), params);
+    return refine_icp(make_icp_pyramid(moved(source_points, placement), params, PyramidRole::kSource),
+                      make_icp_pyramid(moved(target_points, placement), params, PyramidRole::kTarget),
+                      Eigen::Matrix4d::Identity(), params);
   };
   const IcpResult at_origin = run(Eigen::Matrix4d::Identity()), away = run(far);
   ASSERT_TRUE(at_origin.converged);
@@ -106,8 +107,8 @@ TEST(Icp, WithoutIterationsItOnlyMeasuresThePose) {
   IcpParams params;
   params.voxel_m = 0.02;
   params.max_iterations = 0;
-  const IcpPyramid source = make_icp_pyramid(points, params, false);
-  const IcpPyramid target = make_icp_pyramid(points, params, true);
+  const IcpPyramid source = make_icp_pyramid(points, params, PyramidRole::kSource);
+  const IcpPyramid target = make_icp_pyramid(points, params, PyramidRole::kTarget);
   const IcpResult exact = refine_icp(source, target, Eigen::Matrix4d::Identity(), params);
   Eigen::Matrix4d off = Eigen::Matrix4d::Identity();
   off.topRightCorner<3, 1>() = Eigen::Vector3d(0.1, 0.0, 0.0);

@@ -85,8 +85,8 @@ TEST(Levelled, IcpTurnsOnlyAboutZ) {
   IcpParams params;
   params.voxel_m = 0.05;
   params.levelled = true;
-  const IcpPyramid source = make_icp_pyramid(cloud.points, params, false);
-  const IcpPyramid target = make_icp_pyramid(moved, params, true);
+  const IcpPyramid source = make_icp_pyramid(cloud.points, params, PyramidRole::kSource);
+  const IcpPyramid target = make_icp_pyramid(moved, params, PyramidRole::kTarget);
   const IcpResult result = refine_icp(source, target, Eigen::Matrix4d::Identity(), params);
   EXPECT_TRUE(is_levelled(result.transform));
   EXPECT_LT(rotation_error_deg(result.transform, truth), 0.05);

@@ -30,8 +30,10 @@ Scene bunny(double sigma_m) {
     if (p.source == "bun045.ply" && p.target == "bun000.ply") pair = p;
   Scene s;
   s.icp.voxel_m = sigma_m;
-  s.source = make_icp_pyramid(voxel_grid(read_cloud(kBunny + pair.source), sigma_m).cloud.points, s.icp, false);
-  s.target = make_icp_pyramid(voxel_grid(read_cloud(kBunny + pair.target), sigma_m).cloud.points, s.icp, true);
+  s.source =
+      make_icp_pyramid(voxel_grid(read_cloud(kBunny + pair.source), sigma_m).cloud.points, s.icp, PyramidRole::kSource);
+  s.target =
+      make_icp_pyramid(voxel_grid(read_cloud(kBunny + pair.target), sigma_m).cloud.points, s.icp, PyramidRole::kTarget);
   s.truth = pair.T_target_source;
   return s;
 }
@@ -86,8 +88,8 @@ TEST(PoseScore, SelfAgreementFallsWithNoiseAndSetsTheBar) {
   EXPECT_LT(self, 0.8);
   IcpParams icp;
   icp.voxel_m = kSigma;
-  const IcpPyramid from = make_icp_pyramid(voxel_grid(source, kSigma).cloud.points, icp, false);
-  const IcpPyramid to = make_icp_pyramid(voxel_grid(target, kSigma).cloud.points, icp, true);
+  const IcpPyramid from = make_icp_pyramid(voxel_grid(source, kSigma).cloud.points, icp, PyramidRole::kSource);
+  const IcpPyramid to = make_icp_pyramid(voxel_grid(target, kSigma).cloud.points, icp, PyramidRole::kTarget);
   const PoseScorer scorer(from, to, nullptr, 0.5);
   EXPECT_GE(scorer.surface_agreement(refine_icp(from, to, pair.T_target_source, icp).transform), kMinSurfaceAgreement * self);
   Eigen::Matrix4d off = Eigen::Matrix4d::Identity();

@@ -26,7 +26,8 @@ Eigen::Matrix3d constraint_of(const std::vector<Eigen::Vector3f>& points) {
   IcpParams params;
   params.voxel_m = 0.1;
   params.stages = 1;
-  const IcpPyramid source = make_icp_pyramid(points, params, false), target = make_icp_pyramid(points, params, true);
+  const IcpPyramid source = make_icp_pyramid(points, params, PyramidRole::kSource),
+                   target = make_icp_pyramid(points, params, PyramidRole::kTarget);
   return normalized_constraint(refine_icp(source, target, Eigen::Matrix4d::Identity(), params).translation_information);
 }
 

@@ -39,8 +39,8 @@ double estimate_overlap(const PreparedScan& source, const PreparedScan& target, 
   icp.voxel_m = sigma;
   icp.max_iterations = params.icp_max_iterations;
   icp.levelled = params.levelled;
-  const PoseScorer scorer(source.pyramid(sigma, icp, false, cancel), target.pyramid(sigma, icp, true, cancel), nullptr,
-                          overlap);
+  const PoseScorer scorer(source.pyramid(sigma, icp, PyramidRole::kSource, cancel),
+                          target.pyramid(sigma, icp, PyramidRole::kTarget, cancel), nullptr, overlap);
   double best = 0.0;
   for (const Hypothesis& h : matched.hypotheses) best = std::max(best, scorer.score(h.transform));
   return best;

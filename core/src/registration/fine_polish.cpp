@@ -34,8 +34,9 @@ IcpResult polish_winner(const PreparedScan& source, const PreparedScan& target, 
   IcpParams fine = params;
   fine.stages = 1;
   fine.converged_step_voxels = params.converged_step_voxels * sigma_m / target_m;
-  const IcpResult finer = refine_icp(thin_pyramid(source.pyramid(source_m, fine, false, cancel), kFinePolishSourcePoints),
-                                     target.pyramid(target_m, fine, true, cancel), polished.transform, fine, cancel);
+  const IcpResult finer =
+      refine_icp(thin_pyramid(source.pyramid(source_m, fine, PyramidRole::kSource, cancel), kFinePolishSourcePoints),
+                 target.pyramid(target_m, fine, PyramidRole::kTarget, cancel), polished.transform, fine, cancel);
   // The figures at sigma's stage, for the finer pose (no iterations: the final accumulation only).
   at_sigma.max_iterations = 0;
   IcpResult out = refine_icp(source_at_sigma, target_at_sigma, finer.transform, at_sigma, cancel);

@@ -118,7 +118,7 @@ std::vector<Eigen::Vector3f> estimate_normals(const std::vector<Eigen::Vector3f>
   return normals;
 }
 
-IcpPyramid make_icp_pyramid(const std::vector<Eigen::Vector3f>& points, const IcpParams& params, bool as_target,
+IcpPyramid make_icp_pyramid(const std::vector<Eigen::Vector3f>& points, const IcpParams& params, PyramidRole role,
                             const CancellationToken* cancel) {
   IcpPyramid pyramid;
   pyramid.stages.resize(params.stages);  // final addresses first: a grid refers to its stage's points
@@ -128,7 +128,7 @@ IcpPyramid make_icp_pyramid(const std::vector<Eigen::Vector3f>& points, const Ic
     s.voxel_m = params.voxel_m * std::pow(2.0, params.stages - 1 - stage);
     s.points = stage == params.stages - 1 ? points : downsample(points, s.voxel_m);
   }
-  if (as_target) add_target_search(pyramid, params, cancel);
+  if (role == PyramidRole::kTarget) add_target_search(pyramid, params, cancel);
   return pyramid;
 }
 

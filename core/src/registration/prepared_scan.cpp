@@ -133,14 +133,14 @@ const VoxelizedCloud& PreparedScan::voxels(double sigma_m, const CancellationTok
   return cache_->voxels.get(sigma_m, [&] { return voxel_grid(*cloud_, sigma_m, cancel); });
 }
 
-const IcpPyramid& PreparedScan::pyramid(double sigma_m, const IcpParams& params, bool as_target,
+const IcpPyramid& PreparedScan::pyramid(double sigma_m, const IcpParams& params, PyramidRole role,
                                         const CancellationToken* cancel) const {
   IcpParams at_sigma = params;
   at_sigma.voxel_m = sigma_m;
   Pyramid& entry = cache_->pyramids.get({sigma_m, params.stages, params.max_distance_factor}, [&] {
-    return make_icp_pyramid(voxels(sigma_m, cancel).cloud.points, at_sigma, false, cancel);
+    return make_icp_pyramid(voxels(sigma_m, cancel).cloud.points, at_sigma, PyramidRole::kSource, cancel);
   });
-  if (as_target)
+  if (role == PyramidRole::kTarget)
     std::call_once(entry.target_search, [&] {
       add_target_search(entry.pyramid, at_sigma, cancel);
       entry.bytes.store(bytes_of(entry.pyramid), std::memory_order_relaxed);
@@ -233,7 +233,8 @@ double PreparedScan::surface_self_agreement(double sigma_m, const CancellationTo
     IcpParams one_stage;
     one_stage.voxel_m = sigma_m;
     one_stage.stages = 1;
-    const IcpPyramid surface = make_icp_pyramid(voxel_grid(halves[0], sigma_m, cancel).cloud.points, one_stage, true, cancel);
+    const IcpPyramid surface =
+        make_icp_pyramid(voxel_grid(halves[0], sigma_m, cancel).cloud.points, one_stage, PyramidRole::kTarget, cancel);
     const std::vector<Eigen::Vector3f> other = every_kth(voxel_grid(halves[1], sigma_m, cancel).cloud.points, 30000);
     return surface_agreement(other, Eigen::Matrix4d::Identity(), surface.stages.front());
   });

@@ -423,8 +423,8 @@ void ScalePipeline::see_free_space() {
 const PyramidPair& ScalePipeline::icp_pyramids() {
   if (!pyramids_)
     pyramids_.emplace(stages_.run("icp_setup", [&] {
-      return PyramidPair(source_scan_.pyramid(sigma_, icp_params_, false, cancel_),
-                         target_scan_.pyramid(sigma_, icp_params_, true, cancel_));
+      return PyramidPair(source_scan_.pyramid(sigma_, icp_params_, PyramidRole::kSource, cancel_),
+                         target_scan_.pyramid(sigma_, icp_params_, PyramidRole::kTarget, cancel_));
     }));
   return *pyramids_;
 }
@@ -485,7 +485,8 @@ CoarseAlignment ScalePipeline::coarse(KeypointSignal signal, double overlap, std
   //    voxelised clouds, where the furniture that breaks a room's symmetry is visible.
   const PyramidPair& icp = icp_pyramids();
   out.guarded = stages_.run("symmetry_guard", [&] {
-    return rank_hypotheses(icp.first, icp.second, matched.hypotheses, overlap, seen_, params_.levelled, cancel_);
+    return rank_hypotheses(icp.first, icp.second, matched.hypotheses,
+                           {.overlap = overlap, .levelled = params_.levelled}, seen_, cancel_);
   });
   return out;
 }
@@ -542,8 +543,8 @@ CoarseOutcome ScalePipeline::given(const std::vector<Eigen::Matrix4d>& poses) {
     hypotheses[i].transform = to_local_frames(poses[i], source_scan_.cloud().origin_m, target_scan_.cloud().origin_m);
   const PyramidPair& icp = icp_pyramids();
   judged.guarded = stages_.run("symmetry_guard", [&] {
-    return rank_hypotheses(icp.first, icp.second, std::move(hypotheses), judged.overlap, seen_, params_.levelled,
-                           cancel_);
+    return rank_hypotheses(icp.first, icp.second, std::move(hypotheses),
+                           {.overlap = judged.overlap, .levelled = params_.levelled}, seen_, cancel_);
   });
   return out;
 }
@@ -576,8 +577,9 @@ ScaleAttempt ScalePipeline::refine(const CoarseOutcome& coarse) {
       repeats_under_a_shift(verdict.hypotheses, centroid(icp.first.stages.front().points),
                             2.0 * icp.second.stages.front().voxel_m)) {
     const SymmetryGuardResult wider = stages_.run("symmetry_guard", [&] {
-      return rank_hypotheses(icp.first, icp.second, verdict.hypotheses, result_.overlap_used, seen_,
-                             params_.levelled, cancel_, true);
+      return rank_hypotheses(icp.first, icp.second, verdict.hypotheses,
+                             {.overlap = result_.overlap_used, .levelled = params_.levelled, .periodic = true}, seen_,
+                             cancel_);
     });
     verdict = judge(wider);
   }

@@ -154,8 +154,8 @@ double cloud_score(const ScoredSource& scored, const IcpPyramid::Stage& referenc
 }
 
 SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& target,
-                                    std::vector<Hypothesis> hypotheses, double overlap, const ScanViews* views,
-                                    bool levelled, const CancellationToken* cancel, bool periodic) {
+                                    std::vector<Hypothesis> hypotheses, const RankingOptions& options,
+                                    const ScanViews* views, const CancellationToken* cancel) {
   constexpr int kStages = 2, kIterations = 6;  // settle, don't polish: the final ICP does that
   // A pose settles on a few thousand points and is scored on ten thousand (a share to within ~0.5 %: the
   // contenders are scored again on up to 30 000 once refined).
@@ -170,7 +170,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   IcpParams quick;
   quick.stages = kStages;
   quick.max_iterations = kIterations;
-  quick.levelled = levelled;
+  quick.levelled = options.levelled;
   quick.converged_step_voxels = kSettledStepVoxels;
   // A hypothesis can be a metre or two off where it matters, beyond the guard's ICP stages: a 4PCS fit on
   // keypoints a few metres apart tilts a wide outdoor scene by degrees, and a twin's estimated centre is
@@ -181,19 +181,20 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   wide.voxel_m = 2.0 * source.stages.front().voxel_m;
   wide.stages = 2;
   wide.max_iterations = 10;
-  wide.levelled = levelled;
+  wide.levelled = options.levelled;
   wide.converged_step_voxels = kSettledStepVoxels;
-  const IcpPyramid wide_source = thin_pyramid(make_icp_pyramid(source.stages.front().points, wide, false, cancel), kSettlePoints);
-  const IcpPyramid wide_target = make_icp_pyramid(target.stages.front().points, wide, true, cancel);
+  const IcpPyramid wide_source =
+      thin_pyramid(make_icp_pyramid(source.stages.front().points, wide, PyramidRole::kSource, cancel), kSettlePoints);
+  const IcpPyramid wide_target = make_icp_pyramid(target.stages.front().points, wide, PyramidRole::kTarget, cancel);
   auto settle = [&](Hypothesis& h, bool from_afar) {
     const Eigen::Matrix4d start = h.transform;
     h.transform = refine_icp(settling_source, target, start, quick, cancel).transform;
-    h.cloud_score = cloud_score(scored, reference, grid, tau, h.transform, views, overlap);
+    h.cloud_score = cloud_score(scored, reference, grid, tau, h.transform, views, options.overlap);
     if (!from_afar) return;
     const Eigen::Matrix4d pulled = refine_icp(wide_source, wide_target, start, wide, cancel).transform;
     if (!distinct_transforms(pulled, h.transform, source_centre, 1.0, target.stages.front().voxel_m)) return;  // same basin
     const Eigen::Matrix4d settled = refine_icp(settling_source, target, pulled, quick, cancel).transform;
-    const double score = cloud_score(scored, reference, grid, tau, settled, views, overlap);
+    const double score = cloud_score(scored, reference, grid, tau, settled, views, options.overlap);
     if (score > h.cloud_score) {
       h.transform = settled;
       h.cloud_score = score;
@@ -207,9 +208,10 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
     tbb::parallel_for(std::size_t{0}, list.size(), [&](std::size_t i) { settle(list[i], from_afar); });
   };
   // Hypotheses that a verdict has refined already (a periodic search) are only scored again.
-  if (periodic)
+  if (options.periodic)
     tbb::parallel_for(std::size_t{0}, hypotheses.size(), [&](std::size_t i) {
-      hypotheses[i].cloud_score = cloud_score(scored, reference, grid, tau, hypotheses[i].transform, views, overlap);
+      hypotheses[i].cloud_score =
+          cloud_score(scored, reference, grid, tau, hypotheses[i].transform, views, options.overlap);
     });
   else
     settle_all(hypotheses, true);
@@ -234,7 +236,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
     };
     // Levelled scans have one symmetry axis to try: the vertical.
     const auto axes = [&](const Eigen::Matrix3d& principal) {
-      return levelled ? half_turns(Eigen::Vector3d::UnitZ(), centre) : half_turns(principal, centre);
+      return options.levelled ? half_turns(Eigen::Vector3d::UnitZ(), centre) : half_turns(principal, centre);
     };
     const std::vector<Eigen::Matrix4d> principal_turns = axes(point_axes(coarse_target.points, centre));
     const std::vector<Eigen::Matrix4d> normal_turns = axes(normal_axes(coarse_target.normals));
@@ -264,10 +266,10 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
       return std::any_of(done.begin(), done.end(),
                          [&](const Eigen::Matrix4d& d) { return !distinct_transforms(d, t, source_centre, 2.0, 2.0 * voxel_m); });
     };
-    for (int round = 0; round < (periodic ? kMaxRounds : 1); ++round) {
+    for (int round = 0; round < (options.periodic ? kMaxRounds : 1); ++round) {
       const Eigen::Matrix4d best = hypotheses.front().transform;
       const bool twins_only = !among(twinned, best);
-      if (!twins_only && (!periodic || decisive() || among(shifted, best))) break;
+      if (!twins_only && (!options.periodic || decisive() || among(shifted, best))) break;
       // With free space, a best that is not well supported may be a wrong pose that outscored a flip of the
       // truth: the runner-up's twins compete too.
       std::vector<Eigen::Matrix4d> expanded{best};

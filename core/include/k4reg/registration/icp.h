@@ -51,16 +51,19 @@ struct IcpPyramid {
   std::vector<Stage> stages;
 };
 
-// points: at spacing params.voxel_m (coarser stages are voxelised from them). as_target: with each stage's
-// neighbour grid and normals (add_target_search), which the target of a registration needs.
-IcpPyramid make_icp_pyramid(const std::vector<Eigen::Vector3f>& points, const IcpParams& params, bool as_target,
+// Which side of a registration a pyramid serves: the target's stages carry neighbour grids and normals
+// (add_target_search), which cost a grid build and a PCA per point; the source's need neither.
+enum class PyramidRole { kSource, kTarget };
+
+// points: at spacing params.voxel_m (coarser stages are voxelised from them).
+IcpPyramid make_icp_pyramid(const std::vector<Eigen::Vector3f>& points, const IcpParams& params, PyramidRole role,
                             const CancellationToken* cancel = nullptr);
 // Every k-th point, at most max_points of them: an even subsample of a voxelised cloud, in its order.
 std::vector<Eigen::Vector3f> every_kth(const std::vector<Eigen::Vector3f>& points, std::size_t max_points);
 // every_kth of each stage, at most max_points per stage (a source for ICP: no grids, no normals).
 // A pose needs thousands of well-spread correspondences; ICP's cost is linear in them.
 IcpPyramid thin_pyramid(const IcpPyramid& pyramid, std::size_t max_points);
-// Adds the neighbour grids and normals to a pyramid made without them (the same as making it as_target).
+// Adds the neighbour grids and normals to a pyramid made without them (the same as making it as PyramidRole::kTarget).
 void add_target_search(IcpPyramid& pyramid, const IcpParams& params, const CancellationToken* cancel = nullptr);
 
 IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const Eigen::Matrix4d& initial,

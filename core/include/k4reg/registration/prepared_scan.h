@@ -48,8 +48,8 @@ class PreparedScan {
   std::size_t bytes() const;
   const Sampling& sampling() const;
   const VoxelizedCloud& voxels(double sigma_m, const CancellationToken* cancel) const;
-  // At sigma_m's voxels, with params' stages; as_target adds the neighbour grids and normals.
-  const IcpPyramid& pyramid(double sigma_m, const IcpParams& params, bool as_target,
+  // At sigma_m's voxels, with params' stages; PyramidRole::kTarget adds the neighbour grids and normals.
+  const IcpPyramid& pyramid(double sigma_m, const IcpParams& params, PyramidRole role,
                             const CancellationToken* cancel) const;
   // use_intensity: whether the pair uses intensity (both scans have it); see make_surface_signal.
   const ScanKeypoints& keypoints(double sigma_m, KeypointSignal signal, bool use_intensity, const DogParams& dog,

@@ -16,8 +16,7 @@
 #include "k4reg/registration/ambiguity_margin.h"
 #include "k4reg/registration/hypothesis.h"
 #include "k4reg/registration/registration_params.h"
-#include "k4reg/registration/scanner_position.h"
-#include "k4reg/util/stage_timing.h"
+#include "k4reg/registration/registration_result.h"
 
 namespace k4reg {
 
@@ -25,44 +24,6 @@ namespace k4reg {
 // (PreparedScan::surface_self_agreement: 0.99 or more on clean scans, less on noisy ones) is not taken as well
 // supported.
 constexpr double kMinSurfaceAgreement = 0.75;
-
-struct RegistrationResult {
-  Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();  // source -> target, in the files' frames
-  double rmse_m = 0.0;          // RMS of the inlier residuals after refinement
-  double overlap = 0.0;         // share of voxelised source points with a target neighbour after alignment
-  std::size_t inliers = 0;
-  // How firmly the matched surfaces pin the translation per direction, in the target's frame (trace 3; the
-  // identity when surfaces face every way; see translation_constraint.h).
-  Eigen::Matrix3d constraint = Eigen::Matrix3d::Zero();
-  std::size_t source_points = 0, target_points = 0;
-  std::size_t source_voxels = 0, target_voxels = 0;
-  std::size_t source_keypoints = 0, target_keypoints = 0;
-  std::string signal;           // "intensity" or "geometric" (or "voxels" for plain 4PCS)
-  bool free_space_used = false;
-  // Where each scan's scanner stood (file frames), and where that comes from: what the free space is seen from.
-  ScannerPosition source_scanner, target_scanner;
-  double min_scale_m_used = 0.0;  // the scale the result was found at
-  double overlap_used = 0.0;      // the overlap whose bases found it
-  // (best - runner-up) / best, on the evidence that decided (fine geometry and intensity); small = ambiguous.
-  double ambiguity_margin = 0.0;
-  // The evidence cannot tell the best pose from a runner-up (margin under ambiguous_below: ambiguity_margin.h), or the
-  // best pose is poorly supported: treat the transform as one of several candidates (see hypotheses).
-  bool ambiguous = false;
-  std::string ambiguity_reason;  // why, in words; empty when not ambiguous
-  // The best pose lies on the target surface and explains what a true pose would (a pose flagged
-  // ambiguous only for a close runner-up is still well supported; one flagged off the surface or poorly
-  // supported is not).
-  bool well_supported = false;
-  std::vector<Hypothesis> hypotheses;  // best first
-  // The points 4PCS matched (DoG keypoints, or the coarse grid of plain 4PCS) at the scale used, each in its
-  // file's frame: for looking at (the QA report), a few thousand each.
-  std::vector<Eigen::Vector3d> source_keypoint_positions_m, target_keypoint_positions_m;
-  int bases_tried = 0;
-  std::uint64_t seed = 0;
-  bool icp_converged = false;
-  int icp_iterations = 0;
-  std::vector<StageTiming> timings;
-};
 
 // Throws kInvalidArgument naming the first parameter out of range.
 void validate(const RegistrationParams& params);

@@ -58,14 +58,18 @@ ScoredSource scored_source(const IcpPyramid::Stage& stage, std::size_t max_point
 double cloud_score(const ScoredSource& source, const IcpPyramid::Stage& reference, const NeighborGrid& grid,
                    float tau, const Eigen::Matrix4d& t, const ScanViews* views, double overlap);
 
-// Uses the two coarsest levels of the ICP pyramids and scores on the second. overlap: the expected share
-// of the source the target sees (the registration's parameter). levelled: the scanners' z axes are vertical,
-// so hypotheses settle by rotations about z only and the symmetric twins are half-turns about z.
-// periodic: while no hypothesis stands out, also try the best one's shifted copies (for a result the
-// verdict could not decide: it costs up to 48 more settles).
+// How rank_hypotheses settles and expands the hypotheses.
+struct RankingOptions {
+  double overlap = 0.0;   // the expected share of the source the target sees (the registration's parameter)
+  bool levelled = false;  // the scanners' z axes are vertical: settle by rotations about z, twins turn about z
+  // While no hypothesis stands out, also try the best one's shifted copies (for a result the verdict could not
+  // decide; the hypotheses are refined already and only scored again): up to 48 more settles.
+  bool periodic = false;
+};
+
+// Uses the two coarsest levels of the ICP pyramids and scores on the second.
 SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& target,
-                                    std::vector<Hypothesis> hypotheses, double overlap, const ScanViews* views,
-                                    bool levelled = false, const CancellationToken* cancel = nullptr,
-                                    bool periodic = false);
+                                    std::vector<Hypothesis> hypotheses, const RankingOptions& options,
+                                    const ScanViews* views, const CancellationToken* cancel = nullptr);
 
 }  // namespace k4reg
