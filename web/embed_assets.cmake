@@ -1,14 +1,26 @@
-# Writes OUTPUT: a C++ file defining k4reg::web::asset(name) over the files in ASSETS (by file name), each as
-# raw string literals in chunks. "http://" and "https://" become "http:\/\/" and "https:\/\/": the same text in the
-# JavaScript strings and comments where three.js has them (XML namespaces, credits), and no address in a page
-# that must not reference the network.
+# Writes OUTPUT: a C++ file defining k4reg::web::asset(name) over the files in ASSETS, each as raw string literals
+# in chunks. A file under ROOT (web/) is named by its path there ("view/model.js"), any other by its file name
+# ("three.min.js"); two files of one name are an error. "http://" and "https://" become "http:\/\/" and
+# "https:\/\/": the same text in the JavaScript strings and comments where three.js has them (XML namespaces,
+# credits), and no address in a page that must not reference the network.
 set(delimiter "k4reg_asset")
 set(chunk 30000)
 set(arrays "")
 set(body "")
 set(index 0)
+set(names "")
 foreach(asset ${ASSETS})
-  get_filename_component(name ${asset} NAME)
+  string(FIND "${asset}" "${ROOT}/" under_root)
+  if(under_root EQUAL 0)
+    file(RELATIVE_PATH name ${ROOT} ${asset})
+  else()
+    get_filename_component(name ${asset} NAME)
+  endif()
+  list(FIND names ${name} seen)
+  if(NOT seen EQUAL -1)
+    message(FATAL_ERROR "two assets named ${name}")
+  endif()
+  list(APPEND names ${name})
   file(READ ${asset} text)
   string(REPLACE "http://" "http:\\/\\/" text "${text}")
   string(REPLACE "https://" "https:\\/\\/" text "${text}")

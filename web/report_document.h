@@ -1,4 +1,4 @@
-// The document the QA view shows (web/view.js): what was registered, with which parameters, the result as
+// The document the QA view shows (web/view/): what was registered, with which parameters, the result as
 // `--json` prints it and the preview of the registered clouds (float32 arrays as base64). The CLI's `--report`
 // writes it into the page; the server's page builds the same from the HTTP API's answer.
 // Cost: the preview's bytes, a third more as base64 (about 21 bytes per preview point in all).

@@ -11,7 +11,8 @@
 
 namespace k4reg::web {
 
-// An embedded file by name ("k4reg.html", "view.js", "three.min.js", ...); empty when there is none.
+// An embedded file by name: its path under web/ ("k4reg.html", "view/model.js") or, for three.js, its file name
+// ("three.min.js", "OrbitControls.js"); empty when there is none.
 std::string_view asset(std::string_view name);
 
 // The page; `document` null = the server's upload page.
