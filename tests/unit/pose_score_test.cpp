@@ -10,6 +10,7 @@
 #include "k4reg/io/cloud_io.h"
 #include "k4reg/io/gt_pairs.h"
 #include "k4reg/geometry/voxel_grid.h"
+#include "k4reg/registration/contender_verdict.h"
 #include "k4reg/registration/prepared_scan.h"
 #include "k4reg/registration/registration.h"
 

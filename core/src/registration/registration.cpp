@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "k4reg/registration/ambiguity_margin.h"
+#include "k4reg/registration/contender_verdict.h"
 #include "k4reg/registration/dog_keypoints.h"
 #include "k4reg/registration/fine_polish.h"
 #include "k4reg/registration/prepared_scan.h"
@@ -32,30 +33,6 @@
 #include "k4reg/geometry/voxel_grid.h"
 
 namespace k4reg {
-namespace {
-
-// Runs the registration's named stages, each timed into the result and reported to the progress callback.
-class StageRunner {
- public:
-  StageRunner(RegistrationResult& result, const ProgressCallback& progress) : result_(result), progress_(progress) {}
-  template <typename F>
-  auto run(const std::string& stage, F&& f) {
-    if (progress_) progress_(stage, 0.0);
-    auto value = [&] {
-      const StageTimer timer(result_.timings, stage);
-      return f();
-    }();
-    if (progress_) progress_(stage, 1.0);
-    return value;
-  }
-
- private:
-  RegistrationResult& result_;
-  const ProgressCallback& progress_;
-};
-
-}  // namespace
-
 void validate(const RegistrationParams& p) {
   auto bad = [](const std::string& what) { fail(ErrorCode::kInvalidArgument, what); };
   if (!(p.min_scale_m == 0.0 || (p.min_scale_m >= 0.001 && p.min_scale_m <= 10.0)))
@@ -166,11 +143,6 @@ double well_supported(double overlap, bool free_space) {
 // while no pose is well supported.
 constexpr double kAutoOverlaps[] = {0.8, 0.6, 0.4};
 
-// Hypotheses whose cloud score is within this share of the best are refined fully and judged again.
-constexpr double kContenderBand = 0.2;
-constexpr std::size_t kMaxContenders = 3;
-constexpr std::size_t kContenderPoints = 15000;  // per ICP stage: a pose to well under a voxel
-
 // Whether two hypotheses nearly as well supported as the best (within the contender band) share a rotation
 // (within 5 degrees) but put the source's centre (centre_m) more than min_shift_m apart: the scene repeats under
 // a shift. In a symmetric room the rivals are turned copies of each other instead.
@@ -187,116 +159,6 @@ bool repeats_under_a_shift(const std::vector<Hypothesis>& hypotheses, const Eige
       if (angle_deg < kSameRotationDeg && shift_at_m(a, b, centre_m) > min_shift_m) return true;
     }
   return false;
-}
-
-// The surface agreement a refined pose needs to count as lying on the target surface: kMinSurfaceAgreement of
-// what the target's own two halves reach (no pose can do better than two samplings of one surface). On clean
-// scans they reach 0.99 or more, so the bar is kMinSurfaceAgreement itself; noise or clutter at the scale
-// lowers both (a 2D scanner swept through an office, cm noise at a 5 cm scale: 0.75). Measured only for a
-// pose under kMinSurfaceAgreement.
-class SurfaceBar {
- public:
-  SurfaceBar(const PreparedScan& target, double sigma_m, const CancellationToken* cancel)
-      : target_(target), sigma_m_(sigma_m), cancel_(cancel) {}
-  bool passes(double agreement) const { return agreement >= kMinSurfaceAgreement || agreement >= required(); }
-  double required() const {
-    if (required_ < 0.0) required_ = kMinSurfaceAgreement * target_.surface_self_agreement(sigma_m_, cancel_);
-    return required_;
-  }
-
- private:
-  const PreparedScan& target_;
-  double sigma_m_;
-  const CancellationToken* cancel_;
-  mutable double required_ = -1.0;
-};
-
-// The verdict on the guard's ranking: the leading hypotheses refined fully and judged again.
-struct Verdict {
-  std::vector<Hypothesis> hypotheses;  // the winner first, the other contenders after it, the rest as they were
-  double margin = 1.0;                 // (winner - runner-up) / winner, on the refined scores
-  bool on_surface = true;              // whether the winner lies on the target surface
-  int iterations = 0;                  // the winner's ICP iterations
-  // The surface agreement of a contender that lies clearly more on the target surface than the winner (by
-  // kAmbiguousMargin of its own) while nearly as well supported; 0 where none does. The two figures then
-  // disagree: a periodic scene's shifted copy can explain as much of the source as the truth (the corridor's
-  // doors, free space seen the same from either station) yet fits its surfaces less closely (held-out corridor
-  // layout 2 in arbitrary frames: the copy 24 m off 0.84 on the surface, the contenders 0.98).
-  double disputed_by = 0.0;
-};
-
-Verdict judge_contenders(const SymmetryGuardResult& guarded, const IcpPyramid& source, const IcpPyramid& target,
-                         const IcpParams& final_params, const PoseScorer& scorer, const SurfaceBar& bar, bool icp,
-                         double sigma, StageRunner& stages, const CancellationToken* cancel) {
-  Verdict verdict;
-  verdict.hypotheses = guarded.hypotheses;
-  verdict.margin = guarded.ambiguity_margin;
-  std::vector<Hypothesis>& hypotheses = verdict.hypotheses;
-  std::size_t contenders = 1;
-  while (contenders < std::min(kMaxContenders, hypotheses.size()) &&
-         hypotheses[contenders].cloud_score >= (1.0 - kContenderBand) * hypotheses.front().cloud_score)
-    ++contenders;
-  // Only contenders carry refined figures (hypotheses judged before may come back from a wider search).
-  for (std::size_t i = contenders; i < hypotheses.size(); ++i) hypotheses[i].refined_score = hypotheses[i].surface_agreement = 0.0;
-  // Contenders refine on a thinned source, side by side (each sum is deterministic); the winner is then
-  // polished on every point at the finest stage, which also gives its quality figures.
-  const IcpPyramid contender_source = thin_pyramid(source, kContenderPoints);
-  const Eigen::Vector3d source_centre = centroid(source.stages.front().points);  // where poses are compared
-  IcpParams contender_params = final_params;
-  contender_params.converged_step_voxels = kSettledStepVoxels;
-  std::vector<IcpResult> refined(contenders);
-  stages.run("icp", [&] {
-    tbb::parallel_for(std::size_t{0}, contenders, [&](std::size_t i) {
-      refined[i] = refine_icp(contender_source, target, hypotheses[i].transform, contender_params, cancel);
-    });
-    return 0;
-  });
-  // Per contender: the share of the source the target explains once refined, and how much of what comes
-  // near the target surface lies on it. Contenders that refined into an earlier one's pose drop out.
-  std::vector<std::size_t> kept;
-  stages.run("verdict", [&] {
-    tbb::parallel_for(std::size_t{0}, contenders, [&](std::size_t i) {
-      Hypothesis& h = hypotheses[i];
-      if (icp) h.transform = refined[i].transform;
-      h.refined_score = scorer.score(h.transform);
-      if (icp) h.surface_agreement = scorer.surface_agreement(h.transform);
-    });
-    for (std::size_t i = 0; i < contenders; ++i)
-      if (std::none_of(kept.begin(), kept.end(), [&](std::size_t k) {
-            return !distinct_transforms(hypotheses[k].transform, hypotheses[i].transform, source_centre, 2.0,
-                                        2.0 * sigma);
-          }))
-        kept.push_back(i);
-    return 0;
-  });
-  // A pose off the target surface cannot be the true one, however well supported: contenders on the
-  // surface rank first, then by support (unrefined poses, with --no-icp, are not judged on the surface).
-  auto on_surface = [&](std::size_t i) { return !icp || bar.passes(hypotheses[i].surface_agreement); };
-  std::stable_sort(kept.begin(), kept.end(), [&](std::size_t a, std::size_t b) {
-    if (on_surface(a) != on_surface(b)) return on_surface(a);
-    return hypotheses[a].refined_score > hypotheses[b].refined_score;
-  });
-  const std::size_t winner = kept[0];
-  verdict.on_surface = on_surface(winner);
-  verdict.iterations = refined[winner].iterations;
-  // The runner-up is the next contender of the winner's kind; failing one, the best unrefined hypothesis.
-  const auto rival = std::find_if(kept.begin() + 1, kept.end(), [&](std::size_t i) { return on_surface(i) == verdict.on_surface; });
-  const double winner_score = hypotheses[winner].refined_score;
-  for (std::size_t i : kept)
-    if (icp && on_surface(i) && hypotheses[i].refined_score >= (1.0 - kContenderBand) * winner_score &&
-        hypotheses[i].surface_agreement * (1.0 - kAmbiguousMargin) > hypotheses[winner].surface_agreement)
-      verdict.disputed_by = std::max(verdict.disputed_by, hypotheses[i].surface_agreement);
-  if (rival != kept.end())
-    verdict.margin = winner_score > 0 ? std::clamp((winner_score - hypotheses[*rival].refined_score) / winner_score, 0.0, 1.0) : 0.0;
-  else if (contenders > 1)
-    verdict.margin = contenders < hypotheses.size()
-                         ? std::clamp(1.0 - hypotheses[contenders].cloud_score / hypotheses[winner].cloud_score, 0.0, 1.0)
-                         : 1.0;
-  std::vector<Hypothesis> reordered;
-  for (std::size_t i : kept) reordered.push_back(hypotheses[i]);
-  reordered.insert(reordered.end(), hypotheses.begin() + contenders, hypotheses.end());
-  hypotheses = std::move(reordered);
-  return verdict;
 }
 
 // The single-scale pipeline's outcome: the result, and whether its pose is well supported.
@@ -331,7 +193,7 @@ class ScalePipeline {
   ScalePipeline(const PreparedScan& source, const PreparedScan& target, const RegistrationParams& params,
                 double sigma, const CancellationToken* cancel, const ProgressCallback& progress)
       : source_scan_(source), target_scan_(target), params_(params), sigma_(sigma), cancel_(cancel),
-        progress_(progress), stages_(result_, progress) {
+        progress_(progress), stages_(result_.timings, progress) {
     result_.seed = params.seed;
     result_.source_points = source.cloud().size();
     result_.target_points = target.cloud().size();
@@ -565,10 +427,8 @@ ScaleAttempt ScalePipeline::refine(const CoarseOutcome& coarse) {
   if (!params_.icp) final_params.max_iterations = 0;  // quality figures only, at the finest stage
   const PoseScorer scorer(icp.first, icp.second, seen_, result_.overlap_used);
   const SurfaceBar bar(target_scan_, sigma_, cancel_);
-  auto judge = [&](const SymmetryGuardResult& guarded) {
-    return judge_contenders(guarded, icp.first, icp.second, final_params, scorer, bar, params_.icp, sigma_, stages_,
-                            cancel_);
-  };
+  const ContenderJudging judging{icp.first, icp.second, scorer, bar, final_params, params_.icp, sigma_};
+  auto judge = [&](const SymmetryGuardResult& guarded) { return judge_contenders(guarded, judging, stages_, cancel_); };
   Verdict verdict = judge(chosen.guarded);
   // Where the verdict cannot decide and the hypotheses show the scene repeating under a shift (a corridor's
   // doors every few metres), the truth may be a shifted copy that 4PCS did not find: the guard searches

@@ -1,21 +1,13 @@
-// How firmly the accepted links hold each scan against a twin placement, where the twin is one motion of a whole
-// set of scans. Moving the scans on one side of a cut to their twins moves them all by the same motion M (in a
-// symmetric hall, one of its half turns), so every link across the cut then takes its candidate for M and loses
-// its margin over that candidate, not over whichever runner-up it scored best. The per-link cut of scan_strength.h
-// weighs each link by its margin over its own best runner-up: a lower bound, since the links' best runner-ups may
-// be different motions (hall layout 3: station 0's three links each lose least to another of the hall's three half
-// turns). So for a scan that bound leaves under kAmbiguousMargin, the twins its side could take as one are tried:
-// the motions that every link across the cut offers a candidate for (a motion some link never found is not a twin
-// the evidence offers, as the per-link rule knows no runner-up its pair did not find either). Against each, every
-// link weighs its margin over its candidate for that motion, or over its best runner-up where it has none; the
-// scan's strength is the cheapest cut over those motions, and the cheapest motion gives its twin placement. Where
-// no motion is offered across, the per-link cut stands.
-// A link's weight, as in scan_strength.h: its margin (two-sided where judged from both sides, with the reverse
-// side's margin as judged, against its best rival there) where its first candidate was chosen and is well
-// supported; at least one pair's worth where a vouching loop confirmed it; else nothing.
-// Cost: nothing more where every scan is held by the per-link cut. Per weakly held scan, per candidate of one link
-// across its cut: O(links across x candidates) pose comparisons and, for a motion all of them offer, one
-// scan_holds.
+// How firmly the accepted links hold each scan against a twin placement that moves a whole set of scans by one
+// motion M (in a symmetric hall, one of its half turns): every link across the cut then takes its candidate for M
+// and loses its margin over that candidate. scan_strength.h's per-link cut weighs each link by its margin over its
+// own best runner-up, a lower bound, since the links' runner-ups may be different motions. So for a scan that bound
+// leaves under kAmbiguousMargin, each motion that every link across the cut offers a candidate for is tried as one
+// twin (a motion some link never found is not a twin the evidence offers): every link weighs its margin over its
+// candidate for that motion; the scan's strength is the cheapest cut over those motions, whose twin placement is
+// reported. Where no motion is offered across, the per-link cut stands. Link weights as in scan_strength.h.
+// Cost: nothing more where every scan is held by the per-link cut. Per weakly held scan: O(links across x
+// candidates) pose comparisons and, per motion all of them offer, one scan_holds.
 #pragma once
 
 #include <Eigen/Core>

@@ -20,11 +20,6 @@
 
 namespace k4reg {
 
-// A refined pose with less surface agreement than this share of what the target's own two halves reach
-// (PreparedScan::surface_self_agreement: 0.99 or more on clean scans, less on noisy ones) is not taken as well
-// supported.
-constexpr double kMinSurfaceAgreement = 0.75;
-
 // Throws kInvalidArgument naming the first parameter out of range.
 void validate(const RegistrationParams& params);
 

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "k4reg/util/cancellation.h"
 #include "k4reg/util/stopwatch.h"
 
 namespace k4reg {
@@ -33,6 +34,27 @@ class StageTimer {
   std::vector<StageTiming>& timings_;
   std::string stage_;
   SteadyClock::time_point start_;
+};
+
+// Runs named stages, each timed into `timings` and reported to the progress callback (0 then 1).
+class StageRunner {
+ public:
+  StageRunner(std::vector<StageTiming>& timings, const ProgressCallback& progress)
+      : timings_(timings), progress_(progress) {}
+  template <typename F>
+  auto run(const std::string& stage, F&& f) {
+    if (progress_) progress_(stage, 0.0);
+    auto value = [&] {
+      const StageTimer timer(timings_, stage);
+      return f();
+    }();
+    if (progress_) progress_(stage, 1.0);
+    return value;
+  }
+
+ private:
+  std::vector<StageTiming>& timings_;
+  const ProgressCallback& progress_;
 };
 
 }  // namespace k4reg
