@@ -208,7 +208,8 @@ class ScalePipeline {
   ScalePipeline& operator=(const ScalePipeline&) = delete;
 
   // Steps 2-4: rounds of bases (with the overlap automatic, fresh ones for smaller overlaps while no pose is well
-  // supported), on the intensity signal first and the geometric one where intensity poses are weak.
+  // supported; with it given, wider ones while no congruent set is found), on the intensity signal first and the
+  // geometric one where intensity poses are weak.
   CoarseOutcome search();
   // Given poses (files' frames) in place of steps 2-3: the symmetry guard ranks them.
   CoarseOutcome given(const std::vector<Eigen::Matrix4d>& poses);
@@ -353,10 +354,16 @@ CoarseAlignment ScalePipeline::coarse(KeypointSignal signal, double overlap, std
   return out;
 }
 
-// The overlaps whose bases are searched, in turn: the given one, or the automatic rounds.
+// The overlaps whose bases are searched, in turn: the automatic rounds, or the given overlap and then the wider
+// automatic ones, narrowest first. A few keypoints (a small object) may form no base as narrow as the given
+// overlap whose match repeats in the other scan; wider bases are the only others there are, and a pose they find
+// must still explain the given overlap.
 std::vector<double> ScalePipeline::overlaps() const {
   if (params_.overlap == 0.0) return {std::begin(kAutoOverlaps), std::end(kAutoOverlaps)};
-  return {params_.overlap};
+  std::vector<double> rounds{params_.overlap};
+  for (auto wider = std::rbegin(kAutoOverlaps); wider != std::rend(kAutoOverlaps); ++wider)
+    if (*wider > params_.overlap) rounds.push_back(*wider);
+  return rounds;
 }
 
 // Intensity first, as in the paper. Where its keypoints do not repeat between the scans (dark, noisy returns at
@@ -370,8 +377,9 @@ CoarseOutcome ScalePipeline::search() {
   std::optional<CoarseAlignment> chosen;
   std::optional<Error> failure;
   CoarseOutcome out;
+  out.overlap_searched = rounds.front();
   for (std::size_t round = 0; round < rounds.size(); ++round) {
-    out.overlap_searched = rounds[round];
+    out.overlap_searched = std::min(out.overlap_searched, rounds[round]);
     // Round 0 keeps the caller's seed; later rounds draw fresh bases.
     const std::uint64_t seed = params_.seed + 0x9E3779B97F4A7C15ULL * round;
     auto attempt = [&](KeypointSignal signal) {
@@ -387,7 +395,10 @@ CoarseOutcome ScalePipeline::search() {
     attempt(params_.signal);
     const double fallback = result_.free_space_used ? kFullySupportedWithFreeSpace : kSignalFallback;
     if (may_fall_back && (!chosen || chosen->best().cloud_score < fallback)) attempt(KeypointSignal::kGeometric);
-    if (chosen && chosen->best().cloud_score >= well_supported(rounds[round], result_.free_space_used)) break;
+    // Given the overlap, wider bases only while none has found a congruent set.
+    if (chosen && (params_.overlap != 0.0 ||
+                   chosen->best().cloud_score >= well_supported(rounds[round], result_.free_space_used)))
+      break;
   }
   if (!chosen) throw *failure;
   out.chosen = std::move(*chosen);
