@@ -1,13 +1,15 @@
 // Where a scan's scanner stood, from the file or from the scan's own sampling: simulated stations moved into
 // arbitrary frames, a real swept-profiler scan (Kurt3D, cm) moved the same way, and clouds with no single scanner.
+#include "k4reg/registration/scanner_position.h"
+
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <string>
 
 #include "k4reg/geometry/sampling.h"
 #include "k4reg/geometry/voxel_grid.h"
 #include "k4reg/io/cloud_io.h"
-#include "k4reg/registration/scanner_position.h"
 #include "k4reg/registration/scanner_sampling.h"
 #include "sim/scanner.h"
 #include "sim/scene.h"
@@ -48,6 +50,18 @@ TEST(ScannerPosition, AStationInAnArbitraryFrameIsFoundFromItsSampling) {
     EXPECT_LT((found.position_m - true_scanner(scan)).norm(), 0.01) << "station " << station;
     EXPECT_NEAR(found.fit.step_rad, scan.step_rad, 0.25 * scan.step_rad);
   }
+}
+
+// The neighbour search and the sampling's spacing run in parallel: the same position and fit on any thread count.
+TEST(ScannerPosition, TheSameEstimateOnOneThreadAsOnMany) {
+  const sim::SimulatedScan scan = lab_station(2, sim::ScanFrame::kArbitrary);
+  ScannerPosition one, many;
+  tbb::task_arena(1).execute([&] { one = locate(scan.cloud); });
+  tbb::task_arena(4).execute([&] { many = locate(scan.cloud); });
+  ASSERT_EQ(one.source, ScannerSource::kEstimated) << one.reason;
+  EXPECT_EQ(one.position_m, many.position_m);
+  EXPECT_EQ(one.fit.share, many.fit.share);
+  EXPECT_EQ(one.fit.step_rad, many.fit.step_rad);
 }
 
 TEST(ScannerPosition, AFilesScanPoseIsTakenWhereTheSamplingAgrees) {

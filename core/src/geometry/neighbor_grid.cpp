@@ -26,6 +26,14 @@ NeighborGrid::NeighborGrid(const std::vector<Eigen::Vector3f>& points, double ce
     ++counts[cell];
     cell_of[i] = cell;
   }
+  int bits = 6;
+  while ((std::size_t{1} << bits) < 16 * counts.size()) ++bits;
+  occupied_.assign((std::size_t{1} << bits) / 64, 0);
+  occupied_shift_ = 64 - bits;
+  for (const Eigen::Vector3i& index : index_of) {
+    const std::uint64_t bit = (pack_voxel_key(index) * 0x9e3779b97f4a7c15ULL) >> occupied_shift_;
+    occupied_[bit >> 6] |= std::uint64_t{1} << (bit & 63);
+  }
   offsets_.assign(counts.size() + 1, 0);
   for (std::size_t c = 0; c < counts.size(); ++c) offsets_[c + 1] = offsets_[c] + counts[c];
   order_.resize(points.size());
@@ -73,8 +81,8 @@ NeighborGrid::NeighborGrid(const std::vector<Eigen::Vector3f>& points, double ce
 }
 
 std::size_t NeighborGrid::bytes() const {
-  return cells_.bytes() + held_bytes(offsets_) + held_bytes(order_) + held_bytes(sorted_) + near_map_.bytes() +
-         held_bytes(near_offsets_) + held_bytes(near_cells_) + held_bytes(near_codes_);
+  return cells_.bytes() + held_bytes(occupied_) + held_bytes(offsets_) + held_bytes(order_) + held_bytes(sorted_) +
+         near_map_.bytes() + held_bytes(near_offsets_) + held_bytes(near_cells_) + held_bytes(near_codes_);
 }
 
 }  // namespace k4reg

@@ -1,5 +1,7 @@
 #include "k4reg/geometry/sampling.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -53,15 +55,16 @@ Sampling measure_sampling(const PointCloud& cloud) {
   // Cells of a few typical neighbour distances of the subsample (a surface of this extent holding m points).
   const double cell_m = 4.0 * out.diameter_m / std::sqrt(static_cast<double>(sample.size()));
   const NeighborGrid grid(sample, cell_m);
-  std::vector<float> nearest;
-  nearest.reserve(sample.size());
-  for (std::size_t i = 0; i < sample.size(); ++i) {
-    float best = std::numeric_limits<float>::max();
-    grid.for_each_within(sample[i], static_cast<float>(cell_m), [&](std::uint32_t k, float d2) {
-      if (k != i && d2 > 0.0f) best = std::min(best, d2);  // duplicates say nothing about the spacing
-    });
-    if (best < std::numeric_limits<float>::max()) nearest.push_back(std::sqrt(best));
-  }
+  // In parallel: near a scanner a cell holds thousands of the sample's points.
+  std::vector<float> nearest(sample.size(), std::numeric_limits<float>::max());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sample.size(), 512), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i)
+      grid.for_each_within(sample[i], static_cast<float>(cell_m), [&](std::uint32_t k, float d2) {
+        if (k != i && d2 > 0.0f) nearest[i] = std::min(nearest[i], d2);  // duplicates say nothing about the spacing
+      });
+  });
+  std::erase(nearest, std::numeric_limits<float>::max());
+  for (float& d : nearest) d = std::sqrt(d);
   if (nearest.empty()) return out;
   std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
   const double median = nearest[nearest.size() / 2];

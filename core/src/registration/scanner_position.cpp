@@ -1,10 +1,11 @@
 #include "k4reg/registration/scanner_position.h"
-#include "k4reg/registration/scanner_sampling.h"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -13,10 +14,9 @@
 #include <optional>
 #include <utility>
 
-#include <fmt/format.h>
-
 #include "k4reg/geometry/hash_map.h"
 #include "k4reg/geometry/voxel_grid.h"
+#include "k4reg/registration/scanner_sampling.h"
 #include "k4reg/util/held_bytes.h"
 #include "k4reg/util/median.h"
 
@@ -85,32 +85,38 @@ NeighbourAngles::NeighbourAngles(const std::vector<Eigen::Vector3f>& points, dou
     }
     if (buckets == 0) break;
     check(cancel);
+    // The look-ups (most of the time) in parallel, the cells filled in point order: the same lists on any thread count.
+    std::vector<std::uint32_t> bucket_of(points.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 16384), [&](const auto& range) {
+      for (std::size_t i = range.begin(); i != range.end(); ++i)
+        bucket_of[i] = around.find(pack_voxel_key(voxel_index(points[i], inverse)));
+    });
     std::vector<std::vector<std::uint32_t>> in_cell(buckets);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const std::uint32_t b = around.find(pack_voxel_key(voxel_index(points[i], inverse)));
-      if (b != VoxelKeyMap::kAbsent) in_cell[b].push_back(static_cast<std::uint32_t>(i));
-    }
+    for (std::size_t i = 0; i < points.size(); ++i)
+      if (bucket_of[i] != VoxelKeyMap::kAbsent) in_cell[bucket_of[i]].push_back(static_cast<std::uint32_t>(i));
     const float radius2 = static_cast<float>(cell * cell);
-    std::vector<std::pair<float, std::uint32_t>> near;
-    for (std::size_t q = 0; q < queries.size(); ++q) {
-      if (!found[q].empty()) continue;
-      const Eigen::Vector3f& p = points[queries[q]];
-      const Eigen::Vector3i home = voxel_index(p, inverse);
-      near.clear();
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx)
-            for (const std::uint32_t k : in_cell[around.find(pack_voxel_key(home + Eigen::Vector3i(dx, dy, dz)))]) {
-              const float d2 = (points[k] - p).squaredNorm();
-              if (d2 > tiny2 && d2 <= radius2) near.emplace_back(d2, k);
-            }
-      // Enough neighbours within this level's radius, or the last level's best.
-      if (near.size() < kNeighbours && level + 1 < kLevels) continue;
-      if (near.size() < 2) continue;
-      const std::size_t kept = std::min(near.size(), kNeighbours);
-      std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(kept), near.end());
-      found[q].assign(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(kept));
-    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, queries.size(), 256), [&](const auto& range) {
+      std::vector<std::pair<float, std::uint32_t>> near;
+      for (std::size_t q = range.begin(); q != range.end(); ++q) {
+        if (!found[q].empty()) continue;
+        const Eigen::Vector3f& p = points[queries[q]];
+        const Eigen::Vector3i home = voxel_index(p, inverse);
+        near.clear();
+        for (int dz = -1; dz <= 1; ++dz)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx)
+              for (const std::uint32_t k : in_cell[around.find(pack_voxel_key(home + Eigen::Vector3i(dx, dy, dz)))]) {
+                const float d2 = (points[k] - p).squaredNorm();
+                if (d2 > tiny2 && d2 <= radius2) near.emplace_back(d2, k);
+              }
+        // Enough neighbours within this level's radius, or the last level's best.
+        if (near.size() < kNeighbours && level + 1 < kLevels) continue;
+        if (near.size() < 2) continue;
+        const std::size_t kept = std::min(near.size(), kNeighbours);
+        std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(kept), near.end());
+        found[q].assign(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(kept));
+      }
+    });
   }
   for (std::size_t q = 0; q < queries.size(); ++q) {
     if (found[q].empty()) continue;
