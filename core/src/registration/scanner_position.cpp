@@ -40,10 +40,12 @@ ScannerSource scanner_source_named(const std::string& name) {
 
 namespace {
 
-// Search cells grow by this factor per level, from the spacing up: far points of a scan are tens of times sparser
-// than its median, and a grid of cells much finer than a query's neighbour distance costs a look-up per cell.
+// Search cells grow by this factor per level, from kLevelFactor spacings up (256 at the last): far points of a scan
+// are tens of times sparser than its median, and a grid of cells much finer than a query's neighbour distance costs a
+// look-up per cell. Cells of one spacing would settle only a third of the queries (six neighbours seldom lie within
+// one spacing) for a pass over the whole cloud; those they settle find the same six in cells four times as large.
 constexpr double kLevelFactor = 4.0;
-constexpr int kLevels = 5;
+constexpr int kLevels = 4;
 constexpr double kAcrossCosine = 0.7071;  // 45 degrees
 constexpr double kMinAngleRatio = 0.25;   // the cosine of 75 degrees
 
@@ -65,7 +67,7 @@ NeighbourAngles::NeighbourAngles(const std::vector<Eigen::Vector3f>& points, dou
   std::vector<std::vector<std::pair<float, std::uint32_t>>> found(queries.size());
   // Duplicates (a point returned twice) are no neighbours: their angle is 0 from anywhere.
   const float tiny2 = static_cast<float>(1e-6 * spacing_m * spacing_m);
-  double cell = spacing_m;
+  double cell = kLevelFactor * spacing_m;
   for (int level = 0; level < kLevels; ++level, cell *= kLevelFactor) {
     // The cells around the queries still open, and one pass over the cloud for the points in them: far cheaper than
     // a grid over the whole cloud, as the queries are a few thousand.
