@@ -9,7 +9,7 @@
 namespace k4reg {
 
 NeighborGrid::NeighborGrid(const std::vector<Eigen::Vector3f>& points, double cell_m, Queries queries)
-    : cell_m_(cell_m), inv_cell_(static_cast<float>(1.0 / cell_m)), cells_(points.size() / 4 + 16) {
+    : cell_m_(cell_m), inv_cell_(static_cast<float>(1.0 / cell_m)), cells_(points.size() / 4 + 16), occupied_(0) {
   if (!(cell_m > 0.0)) fail(ErrorCode::kInvalidArgument, "neighbour grid cell must be positive, got " + std::to_string(cell_m));
   std::vector<std::uint32_t> cell_of(points.size());
   std::vector<std::uint32_t> counts;
@@ -26,14 +26,8 @@ NeighborGrid::NeighborGrid(const std::vector<Eigen::Vector3f>& points, double ce
     ++counts[cell];
     cell_of[i] = cell;
   }
-  int bits = 6;
-  while ((std::size_t{1} << bits) < 16 * counts.size()) ++bits;
-  occupied_.assign((std::size_t{1} << bits) / 64, 0);
-  occupied_shift_ = 64 - bits;
-  for (const Eigen::Vector3i& index : index_of) {
-    const std::uint64_t bit = (pack_voxel_key(index) * 0x9e3779b97f4a7c15ULL) >> occupied_shift_;
-    occupied_[bit >> 6] |= std::uint64_t{1} << (bit & 63);
-  }
+  occupied_ = KeyBits(counts.size());
+  for (const Eigen::Vector3i& index : index_of) occupied_.add(pack_voxel_key(index));
   offsets_.assign(counts.size() + 1, 0);
   for (std::size_t c = 0; c < counts.size(); ++c) offsets_[c + 1] = offsets_[c] + counts[c];
   order_.resize(points.size());
@@ -81,7 +75,7 @@ NeighborGrid::NeighborGrid(const std::vector<Eigen::Vector3f>& points, double ce
 }
 
 std::size_t NeighborGrid::bytes() const {
-  return cells_.bytes() + held_bytes(occupied_) + held_bytes(offsets_) + held_bytes(order_) + held_bytes(sorted_) +
+  return cells_.bytes() + occupied_.bytes() + held_bytes(offsets_) + held_bytes(order_) + held_bytes(sorted_) +
          near_map_.bytes() + held_bytes(near_offsets_) + held_bytes(near_cells_) + held_bytes(near_codes_);
 }
 

@@ -73,6 +73,7 @@ NeighbourAngles::NeighbourAngles(const std::vector<Eigen::Vector3f>& points, dou
     // a grid over the whole cloud, as the queries are a few thousand.
     const float inverse = static_cast<float>(1.0 / cell);
     VoxelKeyMap around(queries.size() * 27);
+    KeyBits near_queries(queries.size() * 27);  // most points lie near none of the queries
     std::uint32_t buckets = 0;
     for (std::size_t q = 0; q < queries.size(); ++q) {
       if (!found[q].empty()) continue;
@@ -81,7 +82,9 @@ NeighbourAngles::NeighbourAngles(const std::vector<Eigen::Vector3f>& points, dou
         for (int dy = -1; dy <= 1; ++dy)
           for (int dx = -1; dx <= 1; ++dx) {
             bool inserted = false;
-            around.find_or_insert(pack_voxel_key(home + Eigen::Vector3i(dx, dy, dz)), buckets, inserted);
+            const std::uint64_t key = pack_voxel_key(home + Eigen::Vector3i(dx, dy, dz));
+            around.find_or_insert(key, buckets, inserted);
+            near_queries.add(key);
             buckets += inserted;
           }
     }
@@ -90,8 +93,10 @@ NeighbourAngles::NeighbourAngles(const std::vector<Eigen::Vector3f>& points, dou
     // The look-ups (most of the time) in parallel, the cells filled in point order: the same lists on any thread count.
     std::vector<std::uint32_t> bucket_of(points.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 16384), [&](const auto& range) {
-      for (std::size_t i = range.begin(); i != range.end(); ++i)
-        bucket_of[i] = around.find(pack_voxel_key(voxel_index(points[i], inverse)));
+      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+        const std::uint64_t key = pack_voxel_key(voxel_index(points[i], inverse));
+        bucket_of[i] = near_queries.may_hold(key) ? around.find(key) : VoxelKeyMap::kAbsent;
+      }
     });
     std::vector<std::vector<std::uint32_t>> in_cell(buckets);
     for (std::size_t i = 0; i < points.size(); ++i)

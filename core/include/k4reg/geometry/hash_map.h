@@ -76,4 +76,35 @@ class VoxelKeyMap {
   std::size_t size_ = 0;
 };
 
+// One bit per hashed key, about 16 bits per expected key: says "absent" for most keys never added, from an array small
+// enough to stay in cache, where a hash map's probe for an absent key costs a cache miss. Searches whose look-ups
+// mostly miss (the congruent-set search's cells, a pass over a whole cloud for the cells around a few queries) test
+// it first.
+class KeyBits {
+ public:
+  explicit KeyBits(std::size_t expected_keys) {
+    int bits = 6;
+    while ((std::size_t{1} << bits) < 16 * expected_keys) ++bits;
+    words_.assign((std::size_t{1} << bits) / 64, 0);
+    shift_ = 64 - bits;
+  }
+  void add(std::uint64_t key) {
+    const std::uint64_t bit = position(key);
+    words_[bit >> 6] |= std::uint64_t{1} << (bit & 63);
+  }
+  bool may_hold(std::uint64_t key) const {
+    const std::uint64_t bit = position(key);
+    return (words_[bit >> 6] >> (bit & 63)) & 1;
+  }
+  std::size_t bytes() const { return held_bytes(words_); }
+
+ private:
+  std::uint64_t position(std::uint64_t key) const {
+    return (key * 0x9e3779b97f4a7c15ULL) >> shift_;
+  }  // Fibonacci hashing
+
+  std::vector<std::uint64_t> words_;
+  int shift_ = 58;
+};
+
 }  // namespace k4reg

@@ -51,7 +51,7 @@ class NeighborGrid {
       for (int y = lo.y(); y <= hi.y(); ++y)
         for (int x = lo.x(); x <= hi.x(); ++x) {
           const std::uint64_t key = pack_voxel_key(Eigen::Vector3i(x, y, z));
-          if (!maybe_occupied(key)) continue;
+          if (!occupied_.may_hold(key)) continue;
           const std::uint32_t cell = cells_.find(key);
           if (cell != VoxelKeyMap::kAbsent) visit(cell);
         }
@@ -118,18 +118,10 @@ class NeighborGrid {
     return a;
   }
 
-  // One bit per hashed occupied key, about 16 bits per cell: most look-ups of an empty cell (the congruent-set
-  // search's) end here, in a bit array that stays in cache, instead of probing the hash map.
-  bool maybe_occupied(std::uint64_t key) const {
-    const std::uint64_t bit = (key * 0x9e3779b97f4a7c15ULL) >> occupied_shift_;
-    return (occupied_[bit >> 6] >> (bit & 63)) & 1;
-  }
-
   double cell_m_;
   float inv_cell_;
   VoxelKeyMap cells_;
-  std::vector<std::uint64_t> occupied_;
-  int occupied_shift_ = 58;
+  KeyBits occupied_;                    // the general search's empty cells (the congruent-set search's) mostly end here
   std::vector<std::uint32_t> offsets_;  // CSR: cell c holds order_[offsets_[c] .. offsets_[c+1])
   std::vector<std::uint32_t> order_;
   std::vector<Eigen::Vector3f> sorted_;  // points[order_[k]]: a cell's points are contiguous in memory
