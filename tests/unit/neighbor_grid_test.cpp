@@ -100,5 +100,30 @@ TEST(NeighborGrid, OneCellAndGeneralPathsVisitInTheSameOrder) {
   }
 }
 
+// A grid built for few queries (the congruent-set search's) takes the general loop, whose empty cells end in
+// KeyBits: still every point within the radius, and only those.
+TEST(NeighborGrid, AGridForFewQueriesFindsExactlyThePointsWithinTheRadius) {
+  std::mt19937 rng(3);
+  const std::vector<Eigen::Vector3f> points = surface_and_clutter(rng);
+  const NeighborGrid grid(points, 0.1, NeighborGrid::Queries::kFew);
+  std::uniform_real_distribution<float> u(-2.5f, 2.5f);
+  for (int k = 0; k < 300; ++k) {
+    const Eigen::Vector3f q(u(rng), u(rng), 0.2f * u(rng));
+    std::vector<std::pair<std::uint32_t, float>> got;
+    grid.for_each_within(q, 0.1f, [&](std::uint32_t i, float d2) { got.emplace_back(i, d2); });
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, brute_force(points, q, 0.1f)) << "query " << q.transpose();
+  }
+}
+
+TEST(KeyBits, HoldsEveryKeyAddedAndFewOthers) {
+  KeyBits bits(1000);
+  for (std::uint64_t key = 0; key < 1000; ++key) bits.add(key * 7919);
+  for (std::uint64_t key = 0; key < 1000; ++key) EXPECT_TRUE(bits.may_hold(key * 7919));
+  int false_positives = 0;
+  for (std::uint64_t key = 0; key < 100000; ++key) false_positives += bits.may_hold(key * 7919 + 1);
+  EXPECT_LT(false_positives, 10000);  // about 16 bits per key: ~6 % of absent keys pass
+}
+
 }  // namespace
 }  // namespace k4reg
