@@ -59,9 +59,8 @@ Sampling measure_sampling(const PointCloud& cloud) {
   std::vector<float> nearest(sample.size(), std::numeric_limits<float>::max());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sample.size(), 512), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i)
-      grid.for_each_within(sample[i], static_cast<float>(cell_m), [&](std::uint32_t k, float d2) {
-        if (k != i && d2 > 0.0f) nearest[i] = std::min(nearest[i], d2);  // duplicates say nothing about the spacing
-      });
+      grid.nearest_within(sample[i], static_cast<float>(cell_m), &nearest[i],
+                          [&](std::uint32_t k, float d2) { return k != i && d2 > 0.0f; });  // duplicates say nothing
   });
   std::erase(nearest, std::numeric_limits<float>::max());
   for (float& d : nearest) d = std::sqrt(d);

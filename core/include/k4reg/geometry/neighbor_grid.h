@@ -61,18 +61,23 @@ class NeighborGrid {
   // own cell first and then only the neighbouring cells that can still hold a nearer point: in a converged
   // ICP most of the 27 are farther away than the match already found.
   int nearest_within(const Eigen::Vector3f& q, float radius_m, float* d2 = nullptr) const {
+    return nearest_within(q, radius_m, d2, [](std::uint32_t, float) { return true; });
+  }
+  // The same among the points that accept(index, squared_distance) lets count.
+  template <typename Accept>
+  int nearest_within(const Eigen::Vector3f& q, float radius_m, float* d2, Accept&& accept) const {
     int best = -1;
     float best_d2 = std::numeric_limits<float>::max();
     auto visit = [&](std::uint32_t cell, float bound) {
       for (std::uint32_t k = offsets_[cell]; k < offsets_[cell + 1]; ++k) {
         const float dd = (sorted_[k] - q).squaredNorm();
-        if (dd <= bound && dd < best_d2) best_d2 = dd, best = static_cast<int>(order_[k]);
+        if (dd <= bound && dd < best_d2 && accept(order_[k], dd)) best_d2 = dd, best = static_cast<int>(order_[k]);
       }
     };
     const float r2 = radius_m * radius_m;
     if (radius_m > cell_m_ || near_offsets_.empty()) {
       for_each_within(q, radius_m, [&](std::uint32_t i, float dd) {
-        if (dd < best_d2) best_d2 = dd, best = static_cast<int>(i);
+        if (dd < best_d2 && accept(i, dd)) best_d2 = dd, best = static_cast<int>(i);
       });
     } else {
       const Around around = cells_around(q);
