@@ -19,6 +19,10 @@ inline constexpr const char* kOursMatch = "match-ours";     // match_4pcs on giv
 inline constexpr const char* kPclMatch = "match-pcl";       // KFPCSInitialAlignment on given keypoints
 inline constexpr const char* kKeypointsOurs = "keypoints-ours";  // our detector once per pair: counts, repeatability
 inline constexpr const char* kKeypointsPcl = "keypoints-pcl";    // PCL's SIFTKeypoint likewise, kept for the trials
+// Feature-based peers (issue 49), on a voxel grid at sigma: FPFH matching instead of 4PCS.
+inline constexpr const char* kPclSacIa = "fpfh-sacia-pcl";          // FPFHEstimationOMP + SAC-IA (fpfh_methods.h)
+inline constexpr const char* kOpen3dRansac = "fpfh-ransac-open3d";  // Open3D FPFH + RANSAC (open3d_peer.h)
+inline constexpr const char* kOpen3dFgr = "fgr-open3d";             // Open3D FPFH + fast global registration
 
 // PCL checks its time cap only between iterations (and SIFTKeypoint has none), so the orchestrator kills
 // a run still going kHardLimitSlack_s after its cap.

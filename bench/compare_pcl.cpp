@@ -1,7 +1,11 @@
 // k4reg-bench-compare: K-4PCS and plain 4PCS, k4reg against PCL 1.13, on simulated TLS scans (the
-// paper's indoor lab and outdoor arch, Tables 2-4) and on the real pairs in /work/shared/data.
+// paper's indoor lab and outdoor arch, Tables 2-4) and on the real pairs in /work/shared/data; beside them
+// the feature-based peers (issue 49): PCL's FPFH + SAC-IA and Open3D 0.16's FPFH + RANSAC and FGR. Open3D's
+// methods need Debian's python3-open3d (`apt-get install python3-open3d`, about 180 MB installed, so not in
+// scripts/install-deps.sh); without it they are skipped and the report says so.
 //
-//   k4reg-bench-compare [--quick] [--suites lab,arch,real] [--only TEXT] [--trials N] [--resume [--redo M | --report-only]]
+//   k4reg-bench-compare [--quick] [--suites lab,arch,real] [--only TEXT] [--trials N] [--methods A,B]
+//                       [--resume [--redo M | --report-only]]
 //       -> bench/results/compare-<mode>-*.csv, *.gp, the journal compare-<mode>-journal.jsonl (see
 //          compare_journal.h) and the "compare-<mode>" block of bench/RESULTS.md
 //   k4reg-bench-compare worker --job JSON          (one run; used by the orchestrator)
@@ -11,7 +15,6 @@
 // the methods interleaved trial by trial, each run in a fresh worker process (see compare_job.h), on a
 // quiet machine (see machine_load.h).
 #include <CLI/CLI.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -35,6 +38,7 @@
 #include "k4reg/io/gt_pairs.h"
 #include "machine_load.h"
 #include "markdown_block.h"
+#include "open3d_peer.h"
 #include "sift_cache.h"
 #include "simulated_scan_cache.h"
 #include "table_format.h"
@@ -52,6 +56,7 @@ struct Options {
   bool report_only = false;  // with --resume: write the outputs from the journal, run nothing
   int trials = -1;  // -1 = the mode's default; 0 = only the keypoint jobs (detectors and truth check)
   std::string suites = "lab,arch,real";
+  std::string methods;  // comma-separated; "" = every method whose library is installed
   std::string only;
   std::string cache_dir = "build-bench/bench-cache";
   std::string results_dir = "bench/results";
@@ -158,17 +163,60 @@ std::vector<Suite> make_suites(const Options& o) {
   return chosen;
 }
 
-// The methods of one case, in the order they take turns within a trial.
-std::vector<std::string> methods_for(const Suite& suite, const Case& c, int trial) {
-  if (suite.keypoints_given) return {kOursMatch, kPclMatch};
-  std::vector<std::string> methods = {kOursK4pcs, kPclK4pcs};
+// Every method a run can have, in the order they take turns within a trial.
+const std::vector<std::string>& all_methods() {
+  static const std::vector<std::string> methods = {kOursK4pcs, kPclK4pcs, kPclSacIa,  kOpen3dRansac, kOpen3dFgr,
+                                                   kOursPlain, kPclPlain, kOursMatch, kPclMatch};
+  return methods;
+}
+
+std::string method_names() {
+  std::string names;
+  for (const std::string& m : all_methods()) names += (names.empty() ? "" : ", ") + m;
+  return names;
+}
+
+bool listed(const std::string& list, const std::string& name) {
+  return ("," + list + ",").find("," + name + ",") != std::string::npos;
+}
+
+// The methods --methods asks for (all by default), less those whose library is missing: their names and
+// why go to `skipped`, for the report.
+std::vector<std::string> selected_methods(const std::string& list, std::map<std::string, std::string>& skipped) {
+  std::istringstream names(list);
+  for (std::string name; std::getline(names, name, ',');)
+    if (std::find(all_methods().begin(), all_methods().end(), name) == all_methods().end())
+      throw std::runtime_error("--methods: unknown method \"" + name + "\" (known: " + method_names() + ")");
+  std::vector<std::string> chosen;
+  for (const std::string& m : all_methods())
+    if (list.empty() || listed(list, m)) chosen.push_back(m);
+  if (std::find(chosen.begin(), chosen.end(), kOpen3dRansac) != chosen.end() ||
+      std::find(chosen.begin(), chosen.end(), kOpen3dFgr) != chosen.end()) {
+    if (const std::string reason = open3d_unavailable_reason(); !reason.empty())
+      for (const char* m : {kOpen3dRansac, kOpen3dFgr})
+        if (std::erase(chosen, m)) skipped[m] = reason;
+  }
+  return chosen;
+}
+
+// The methods of one case, in the order they take turns within a trial, among the selected ones.
+std::vector<std::string> methods_for(const Suite& suite, const Case& c, int trial,
+                                     const std::vector<std::string>& selected) {
+  const auto chosen = [&](std::vector<std::string> methods) {
+    std::erase_if(methods, [&](const std::string& m) {
+      return std::find(selected.begin(), selected.end(), m) == selected.end();
+    });
+    return methods;
+  };
+  if (suite.keypoints_given) return chosen({kOursMatch, kPclMatch});  // FPFH needs surfaces, not keypoints
+  std::vector<std::string> methods = {kOursK4pcs, kPclK4pcs, kPclSacIa, kOpen3dRansac, kOpen3dFgr};
   const auto& pairs = suite.baseline_pairs;
   const bool baseline = suite.baseline && (suite.baseline_size == 0 || suite.baseline_size == c.points) &&
                         (suite.baseline_sigma_m == 0 || suite.baseline_sigma_m == c.job.sigma_m) &&
                         (pairs.empty() || std::find(pairs.begin(), pairs.end(), c.pair) != pairs.end()) &&
                         trial <= (suite.baseline_trials > 0 ? suite.baseline_trials : suite.trials);
   if (baseline) methods.insert(methods.end(), {kOursPlain, kPclPlain});
-  return methods;
+  return chosen(methods);
 }
 
 std::vector<std::pair<int, int>> station_pairs(const Suite& suite, bool quick) {
@@ -394,6 +442,8 @@ std::string skip_reason(const std::string& method, const KeypointStats& k) {
 void print_detector(const char* name, const DetectorStats& d) {
   if (d.ok)
     std::printf(" %s %zu/%zu (repeatability %.0f %%, %.1f s)", name, d.source, d.target, 100 * d.repeatability, d.seconds);
+  else if (d.error.starts_with("not run"))
+    std::printf(" %s %s", name, d.error.c_str());
   else
     std::printf(" %s ERROR %s", name, d.error.c_str());
 }
@@ -426,6 +476,11 @@ int run_comparison(const Options& o, const std::string& command) {
   report.started = now_text();
   report.command = command;
   report.suites = make_suites(o);
+  const std::vector<std::string> selected = selected_methods(o.methods, report.skipped_methods);
+  for (const auto& [method, reason] : report.skipped_methods)
+    std::printf("skipping %s: %s\n", method.c_str(), reason.c_str());
+  // PCL's SIFT serves only its K-4PCS: without it, the keypoint job runs our detector alone.
+  const bool pcl_sift = std::find(selected.begin(), selected.end(), kPclK4pcs) != selected.end();
   const CaseFilter keep = [&](const Case& c) { return case_label(report, c).find(o.only) != std::string::npos; };
   for (std::size_t i = 0; i < report.suites.size(); ++i) {
     if (report.suites[i].sizes.empty()) add_real_cases(i, report.suites[i], o, keep, report.cases);
@@ -449,7 +504,7 @@ int run_comparison(const Options& o, const std::string& command) {
   std::size_t total = 0, done = 0;
   for (const Case& c : report.cases)
     for (int trial = 1; trial <= report.suites[c.suite].trials; ++trial)
-      for (const std::string& method : methods_for(report.suites[c.suite], c, trial)) {
+      for (const std::string& method : methods_for(report.suites[c.suite], c, trial, selected)) {
         ++total;
         ++report.planned[{c.suite, c.points, c.job.sigma_m, method}];
       }
@@ -458,7 +513,7 @@ int run_comparison(const Options& o, const std::string& command) {
     const std::string label = case_label(report, c);
     const Suite& suite = report.suites[c.suite];
     KeypointStats& k = report.keypoints[ci];
-    const auto redone = [&](const std::string& method) { return ("," + o.redo + ",").find("," + method + ",") != std::string::npos; };
+    const auto redone = [&](const std::string& method) { return listed(o.redo, method); };
     if (const auto it = replay.keypoints.find(label); it != replay.keypoints.end() && !redone("keypoints")) {
       k = it->second;
     } else if (o.report_only && !suite.keypoints_given) {
@@ -466,7 +521,10 @@ int run_comparison(const Options& o, const std::string& command) {
     } else if (!suite.keypoints_given) {
       k.ran = true;
       k.ours = run_detector_job(c, kKeypointsOurs, k);
-      k.pcl = run_detector_job(c, kKeypointsPcl, k);
+      if (pcl_sift)
+        k.pcl = run_detector_job(c, kKeypointsPcl, k);
+      else
+        k.pcl.error = std::string("not run: ") + kPclK4pcs + " is not among --methods";
       journal.add(label, k, elapsed());
       ran_any = true;
       std::printf("[%s] %s keypoints:", clock_text(elapsed()).c_str(), label.c_str());
@@ -476,7 +534,7 @@ int run_comparison(const Options& o, const std::string& command) {
     }
     c.job.plain_voxel_m = k.plain_voxel_m;
     for (int trial = 1; trial <= suite.trials; ++trial)
-      for (const std::string& method : methods_for(suite, c, trial)) {
+      for (const std::string& method : methods_for(suite, c, trial, selected)) {
         ++done;
         if (const auto it = replay.runs.find({label, method, trial}); it != replay.runs.end() && !redone(method)) {
           report.runs.push_back(it->second);
@@ -579,6 +637,8 @@ int main(int argc, char** argv) {
                "progress report; rows still missing runs are marked partial)")
       ->needs("--resume");
   app.add_option("--trials", o.trials, "trials per pair and method (default: 3 quick, 10 full; 0: keypoint jobs only)");
+  app.add_option("--methods", o.methods,
+                 "comma-separated methods to run (default: all whose library is installed): " + method_names());
   app.add_option("--suites", o.suites, "comma-separated: lab, arch, real (all real data) or a real set's name")
       ->capture_default_str();
   app.add_option("--only", o.only, "run only the pairs whose label contains this text (e.g. \"lab 0.7M\")");

@@ -23,6 +23,9 @@ const char* method_label(const std::string& method) {
   if (method == kPclPlain) return "4PCS PCL";
   if (method == kOursMatch) return "4PCS stage k4reg";
   if (method == kPclMatch) return "KFPCS stage PCL";
+  if (method == kPclSacIa) return "FPFH + SAC-IA PCL";
+  if (method == kOpen3dRansac) return "FPFH + RANSAC Open3D";
+  if (method == kOpen3dFgr) return "FPFH + FGR Open3D";
   return "?";
 }
 
@@ -180,6 +183,54 @@ std::vector<double> sigmas_of(const Suite& suite) {
 
 // ---- markdown sections ----
 
+// Every system on one suite (issue 49): success as SR counts it (the coarse result against the suite's
+// threshold), the median T per pair, and that median over k4reg's on the same pairs (the plain baselines run on a
+// few pairs only). k4reg is K-4PCS, or its 4PCS stage where the keypoints are given.
+void summary_section(std::ostringstream& md, const Report& report) {
+  md << "#### Summary: every system per suite\n\n"
+     << "| suite | system | success / runs | T s per pair, median | T / k4reg T, same pairs |\n|---|---|---|---|---|\n";
+  for (std::size_t suite = 0; suite < report.suites.size(); ++suite) {
+    std::vector<Row> systems;  // in the order they take turns
+    for (const Run& run : report.runs) {
+      if (report.cases[run.case_index].suite != suite) continue;
+      auto it = std::find_if(systems.begin(), systems.end(), [&](const Row& r) { return r.method == run.method; });
+      if (it == systems.end()) it = systems.insert(systems.end(), Row{suite, 0, 0, run.method, {}, {}});
+      it->runs.push_back(&run);
+      it->cases.insert(run.case_index);
+    }
+    const std::string reference = report.suites[suite].keypoints_given ? kOursMatch : kOursK4pcs;
+    const auto k4reg =
+        std::find_if(systems.begin(), systems.end(), [&](const Row& r) { return r.method == reference; });
+    for (const Row& row : systems) {
+      const std::size_t hits = row.count([](const Run& r) { return r.success_coarse; });
+      const std::size_t capped = row.count([](const Run& r) { return r.capped; });
+      const double t = median(row.collect([](const Run& r) { return r.total_s; }));
+      std::string ratio = "–";
+      if (row.method == reference) {
+        ratio = "(reference)";
+      } else if (k4reg != systems.end()) {
+        std::set<std::pair<std::size_t, int>> runs;  // (case, trial)
+        for (const Run* r : row.runs) runs.insert({r->case_index, r->trial});
+        std::vector<double> k4reg_t;
+        for (const Run* r : k4reg->runs)
+          if (r->ok && runs.count({r->case_index, r->trial})) k4reg_t.push_back(r->total_s);
+        if (median(k4reg_t) > 0) ratio = fmt("%.1f×", t / median(k4reg_t));
+      }
+      md << "| " << report.suites[suite].name << " | " << method_label(row.method) << " | " << hits << " / "
+         << runs_cell(row, report) << (capped ? fmt(" (%.0f over the cap)", capped) : "") << " | " << seconds(t)
+         << " | " << ratio << " |\n";
+    }
+  }
+  md << "\nSuccess: the coarse result within the suite's threshold (as SR below; k4reg's coarse result has had "
+        "its short ICP settles, the peers get no ICP). T: seconds from the two loaded clouds to the transform, the "
+        "method's own preprocessing (voxel grid, keypoints or features) included, file reading and handing the clouds "
+        "to PCL or Open3D not (see below); medians over the runs that returned a transform. T / k4reg T: over the "
+        "same pairs and trials.\n\n";
+  for (const auto& [method, reason] : report.skipped_methods)
+    md << "- Not run: " << method_label(method) << " (`" << method << "`): " << reason << ".\n";
+  if (!report.skipped_methods.empty()) md << "\n";
+}
+
 void configuration_section(std::ostringstream& md, const Report& report) {
   md << "**Configuration** (one per suite, the same for every pair; no per-pair tuning):\n\n"
      << "| suite | data | pairs | σ | overlap | success | trials | plain 4PCS | k4reg bases | PCL iterations "
@@ -282,7 +333,7 @@ void real_table(std::ostringstream& md, const Report& report, const std::vector<
        << percent(repeatability(row, report)) << " |\n";
   }
   md << "\nMAE, MTE and RMSE: medians of the coarse result. \"SR after ICP\": the final transform of k4reg's "
-        "pipeline (PCL's methods have no refinement stage).\n\n";
+        "pipeline (PCL's and Open3D's methods have no refinement stage).\n\n";
 }
 
 std::string stage_cell(const Row& row) {
@@ -372,6 +423,7 @@ void every_row_table(std::ostringstream& md, const Report& report, const std::ve
 }
 
 std::string detector_cells(const DetectorStats& d) {
+  if (!d.ok && d.error.starts_with("not run")) return d.error + " | – | – | –";
   if (!d.ok) return "failed: " + d.error + " | – | ≥ " + seconds(d.seconds) + " | " + number(d.peak_rss_mb, "%.0f");
   return std::to_string(d.source) + " / " + std::to_string(d.target) + " | " + percent(d.repeatability) + " | " +
          seconds(d.seconds) + " | " + number(d.peak_rss_mb, "%.0f");
@@ -554,11 +606,10 @@ std::string markdown(const Report& report, const std::string& results_dir_in_rep
   const std::vector<Row> rows = make_rows(report);
   const std::string stem = results_dir_in_repo + "/compare-" + report.mode;
   std::ostringstream md;
-  md << "### K-4PCS and 4PCS: k4reg vs PCL 1.13 (" << report.mode << " run)\n\n"
+  md << "### K-4PCS and 4PCS: k4reg vs PCL 1.13, beside FPFH peers (PCL, Open3D 0.16) (" << report.mode << " run)\n\n"
      << "Started " << report.started << ", took " << seconds(report.duration_s / 60.0) << " min of machine time"
      << (report.sessions > 1 ? " in " + std::to_string(report.sessions) + " sessions (resumed with --resume)" : "")
-     << ". Command: `"
-     << report.command << "`. Raw data: `" << stem << "-runs.csv` (one line per run), `" << stem
+     << ". Command: `" << report.command << "`. Raw data: `" << stem << "-runs.csv` (one line per run), `" << stem
      << "-rows.csv` (one line per table row).\n\n";
   std::size_t planned = 0;
   for (const auto& [row, count] : report.planned) planned += count;
@@ -566,15 +617,18 @@ std::string markdown(const Report& report, const std::string& results_dir_in_rep
     md << "**In progress:** " << report.runs.size() << " of the " << planned
        << " runs are in so far (a report from the journal, `--report-only`). Rows marked ‡ are partial: not all "
           "their pairs and trials have run, so their figures and the targets below are provisional.\n\n";
+  summary_section(md, report);
   configuration_section(md, report);
   targets_section(md, report, rows);
   md << "How the runs are made:\n\n"
      << "- Every run (one method, one pair, one trial) is a fresh process: its peak RSS (getrusage of that "
         "child) is that method's alone, including its copy of the two clouds; a run still going "
-     << kHardLimitSlack_s << " s after the wall cap is killed and counted as failed, and each process has an address-space cap "
+     << kHardLimitSlack_s
+     << " s after the wall cap is killed and counted as failed, and each process has an address-space cap "
         "(--memory-cap-mb, 12 GB by default; the machine is shared) past which the run fails as out of memory. "
-        "Runs are interleaved (trial 1: k4reg K-4PCS, PCL K-4PCS, k4reg 4PCS, "
-        "PCL 4PCS; trial 2: …).\n"
+        "Runs are interleaved (trial 1: k4reg K-4PCS, PCL K-4PCS, PCL FPFH + SAC-IA, Open3D FPFH + RANSAC, "
+        "Open3D FPFH + FGR, k4reg 4PCS, PCL 4PCS; trial 2: …), each method selected by --methods (default: all whose "
+        "library is installed).\n"
      << "- The machine is shared, so every run is timed on a quiet machine: a run during which other processes "
         "used more than a quarter of a core on average (/proc/stat minus the run's own CPU time) is repeated once "
         "the machine is quiet again (at most 3 attempts; the runs CSV has attempts and foreign_cores).\n"
@@ -596,12 +650,29 @@ std::string markdown(const Report& report, const std::string& results_dir_in_rep
      << "- PCL 4PCS = `VoxelGrid` at the spacing where our voxelised source has about as many points as our "
         "keypoints (the paper's baseline), then `FPCSInitialAlignment` with δ = that spacing (absolute) and the "
         "same settings. k4reg 4PCS = `register_clouds` with method = kPlain4pcs on the same spacing.\n"
+     << "- The feature-based peers (issue 49) all describe a VoxelGrid at σ (V = σ) with FPFH, normals within 2 V, "
+        "features within 5 V, 2 threads, and get no ICP (coarse = final). PCL FPFH + SAC-IA = `VoxelGrid`, "
+        "`NormalEstimationOMP`, `FPFHEstimationOMP` (points without a finite normal or descriptor dropped), then "
+        "`SampleConsensusInitialAlignment` as PCL's template-alignment tutorial sets it: 500 iterations (it has "
+        "no time limit: a run past the cap is a failure like any other), samples ≥ 10 V apart, matches within 2 V "
+        "(setMaxCorrespondenceDistance((2 V)²): its truncated error compares squared distances), seeded with the "
+        "trial (srand). Open3D = "
+        "`bench/open3d_pair.py` with Open3D 0.16 (Debian's python3-open3d) as its global-registration tutorial sets "
+        "it: `voxel_down_sample(V)`, normals `KDTreeSearchParamHybrid(2 V, 30)`, FPFH `KDTreeSearchParamHybrid(5 V, "
+        "100)`; RANSAC = `registration_ransac_based_on_feature_matching` (mutual filter, distance 1.5 V, "
+        "point-to-point, 3 points, edge-length 0.9 and distance 1.5 V checkers, `RANSACConvergenceCriteria(100000, "
+        "0.999)`), FGR = `registration_fgr_based_on_feature_matching` (maximum correspondence distance 0.5 V); "
+        "`o3d.utility.random.seed(trial)`, OMP_NUM_THREADS = 2. It runs as a child of the worker: the worker writes "
+        "the clouds' local-frame points (what PCL gets) to float PLY files; Open3D's T is what the script measures "
+        "from both clouds in memory to the transform, and the rest of the call (writing the files, Python's start-up "
+        "and `import open3d`, about 0.6 s, reading the files) is the runs CSV's convert_s, as copying into PCL clouds "
+        "is for PCL. Peak RSS includes the Python child.\n"
      << "- Coarse = before the final ICP: for k4reg the best hypothesis after its symmetry guard, i.e. what "
         "icp = false returns. The guard settles every hypothesis with a short ICP before ranking, so k4reg's "
         "coarse RMSE is already ICP-grade and not the raw 4PCS-stage error the paper reports (register_clouds "
-        "does not expose that). SR in Tables 2–4 is the coarse success, as in the paper. Real-data sources are moved by a fixed "
-        "random rigid motion (30–180°) first, so that a method returning the identity cannot pass on pairs whose "
-        "true motion is small.\n\n";
+        "does not expose that). SR in Tables 2–4 is the coarse success, as in the paper. Real-data sources are moved "
+        "by a fixed random rigid motion (30–180°) first, so that a method returning the identity cannot pass on "
+        "pairs whose true motion is small.\n\n";
   table2(md, report, rows);
   comparison_table(md, report, rows, "Table 3 – indoor lab (simulated), S = 0.7M: 4PCS vs K-4PCS", "lab", 700000,
                    kPaperTable3);

@@ -1,6 +1,6 @@
 // The comparison's data model (suites, cases, runs) and its outputs: per-run and per-row CSV files,
-// the markdown block of bench/results/comparison-with-pcl.md (the paper's Tables 2-4 with PCL beside us, plus every row in
-// detail) and gnuplot scripts for the plots.
+// the markdown block of bench/results/comparison-with-pcl.md (a summary of every system per suite, the paper's
+// Tables 2-4 with PCL beside us, plus every row in detail) and gnuplot scripts for the plots.
 #pragma once
 
 #include <cstddef>
@@ -95,6 +95,7 @@ struct Report {
   // Runs the configuration asks for, per table row (suite, points, sigma_m, method): a report made before
   // the comparison finished (--report-only) marks its rows partial.
   std::map<std::tuple<std::size_t, std::size_t, double, std::string>, std::size_t> planned;
+  std::map<std::string, std::string> skipped_methods;  // asked for (or by default) but not runnable here: why
 };
 
 // Writes <dir>/compare-<mode>-runs.csv, -rows.csv and the gnuplot scripts -sr-vs-sigma.gp and

@@ -1,18 +1,20 @@
 // The worker side of the comparison: loads one pair, runs one method and reports errors against the
 // ground truth, stage times and keypoint counts as one JSON object.
 //
-// Result fields: ok, error, read_s (file reading, not part of total_s), convert_s (copying into PCL
-// clouds, not part of total_s), total_s (from loaded clouds to the final transform), stages {name: s},
+// Result fields: ok, error, read_s (file reading, not part of total_s), convert_s (handing the clouds to the
+// other library, not part of total_s: copying into PCL clouds; for Open3D writing them to PLY files, Python's
+// start-up with import open3d, reading the files back), total_s (from loaded clouds to the final transform;
+// Open3D's as its script measured it), stages {name: s},
 // source_keypoints, target_keypoints, capped (over the wall-time cap: a failure), coarse and final
-// {mae_deg, mte_m, rotation_deg, translation_m, rmse_m} (coarse = before ICP; PCL has no ICP, so they
-// are equal), sift_overflow_octaves. The keypoint jobs report seconds, source_keypoints, target_keypoints,
-// repeatability, and truth_overlap / plain_voxel_m (ours) or sift_overflow_octaves (PCL). PCL's K-4PCS
-// and SIFT runs also report sift_peak_rss_mb (of the process that computed the keypoints, see
+// {mae_deg, mte_m, rotation_deg, translation_m, rmse_m} (coarse = before ICP; PCL's and Open3D's methods
+// have no ICP, so they are equal), sift_overflow_octaves, voxel_grid_overflow. The keypoint jobs report seconds,
+// source_keypoints, target_keypoints, repeatability, and truth_overlap / plain_voxel_m (ours) or sift_overflow_octaves
+// (PCL). PCL's K-4PCS and SIFT runs also report sift_peak_rss_mb (of the process that computed the keypoints, see
 // sift_cache.h) and, when SIFT was killed on that scan before, sift_timed_out. A worker prints
 // "PROGRESS {...}" lines with facts known before a long stage, then one "RESULT {...}" line.
-#include <Eigen/Geometry>
 #include <sys/resource.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -20,16 +22,18 @@
 #include <random>
 
 #include "compare_job.h"
+#include "fpfh_methods.h"
+#include "k4reg/geometry/neighbor_grid.h"
+#include "k4reg/geometry/voxel_grid.h"
 #include "k4reg/io/cloud_io.h"
 #include "k4reg/registration/dog_keypoints.h"
-#include "k4reg/util/error.h"
-#include "k4reg/util/stopwatch.h"
 #include "k4reg/registration/four_pcs.h"
 #include "k4reg/registration/metrics.h"
-#include "k4reg/geometry/neighbor_grid.h"
 #include "k4reg/registration/registration.h"
 #include "k4reg/registration/surface_signal.h"
-#include "k4reg/geometry/voxel_grid.h"
+#include "k4reg/util/error.h"
+#include "k4reg/util/stopwatch.h"
+#include "open3d_peer.h"
 #include "pcl_methods.h"
 #include "sift_cache.h"
 #include "truth_error.h"
@@ -231,8 +235,24 @@ void run_ours(const Job& job, const LoadedPair& pair, json& out) {
   out["final"] = errors(pair.source, r.transform, pair.truth);
 }
 
+// The peers' threads: both cores, as k4reg's TBB uses them.
+constexpr int kPeerThreads = 2;
+
 PclAlignParams pcl_align_params(const Job& job, double delta_m) {
-  return PclAlignParams{delta_m, job.overlap, job.pcl_iterations, job.cap_s, 2};
+  return PclAlignParams{delta_m, job.overlap, job.pcl_iterations, job.cap_s, kPeerThreads};
+}
+
+// The end of a method without a refinement stage: T is the sum of its stages, and coarse = final.
+void report_unrefined(const Job& job, const LoadedPair& pair, const Eigen::Matrix4d& local, const json& stages,
+                      json& out) {
+  double total = 0.0;
+  for (const auto& [stage, seconds] : stages.items()) total += seconds.get<double>();
+  out["stages"] = stages;
+  out["total_s"] = total;
+  out["capped"] = total > job.cap_s;
+  const json e = errors(pair.source, file_from_local(local, pair.source, pair.target), pair.truth);
+  out["coarse"] = e;
+  out["final"] = e;
 }
 
 void run_pcl(const Job& job, const LoadedPair& pair, json& out) {
@@ -264,14 +284,41 @@ void run_pcl(const Job& job, const LoadedPair& pair, json& out) {
   const Eigen::Matrix4d local = job.method == kPclK4pcs ? pcl_kfpcs(source_set, target_set, params)
                                                        : pcl_fpcs(source_set, target_set, params);
   stages["matching"] = seconds_since(start);
-  double total = 0.0;
-  for (const auto& [stage, seconds] : stages.items()) total += seconds.get<double>();
-  out["stages"] = stages;
-  out["total_s"] = total;
-  out["capped"] = total > job.cap_s;
-  const json e = errors(pair.source, file_from_local(local, pair.source, pair.target), pair.truth);
-  out["coarse"] = e;
-  out["final"] = e;
+  report_unrefined(job, pair, local, stages, out);
+}
+
+// FPFH + SAC-IA: features on both sigma voxel grids, then SAC-IA seeded with the trial.
+void run_sac_ia(const Job& job, const LoadedPair& pair, json& out) {
+  auto start = SteadyClock::now();
+  const PclCloud::Ptr source = to_pcl(pair.source), target = to_pcl(pair.target);
+  out["convert_s"] = seconds_since(start);
+  json stages = json::object();
+  start = SteadyClock::now();
+  const FpfhParams fpfh{.voxel_m = job.sigma_m, .threads = kPeerThreads};
+  const FpfhCloud source_features = pcl_fpfh(source, fpfh), target_features = pcl_fpfh(target, fpfh);
+  stages["features"] = seconds_since(start);
+  out["voxel_grid_overflow"] = source_features.voxel_grid_overflow || target_features.voxel_grid_overflow;
+  out["source_keypoints"] = source_features.points->size();
+  out["target_keypoints"] = target_features.points->size();
+  if (source_features.points->size() < 3 || target_features.points->size() < 3)
+    fail(ErrorCode::kFailedPrecondition, "too few points with an FPFH descriptor");
+  start = SteadyClock::now();
+  const SacIaParams sac_ia{.voxel_m = job.sigma_m, .seed = static_cast<unsigned>(job.seed)};
+  const Eigen::Matrix4d local = pcl_sac_ia(source_features, target_features, sac_ia);
+  stages["matching"] = seconds_since(start);
+  report_unrefined(job, pair, local, stages, out);
+}
+
+// Open3D's FPFH + RANSAC or FGR in a child process (open3d_peer.h). The child gets the cap plus half the
+// orchestrator's slack, so it is killed here before the orchestrator kills this worker and would orphan it.
+void run_open3d(const Job& job, const LoadedPair& pair, json& out) {
+  const Open3dPair r = open3d_pair(pair.source.points, pair.target.points, job.method == kOpen3dFgr ? "fgr" : "ransac",
+                                   job.sigma_m, job.seed, kPeerThreads, job.cap_s + 0.5 * kHardLimitSlack_s);
+  if (r.timed_out) fail(ErrorCode::kDeadlineExceeded, "open3d_pair.py killed after the wall cap");
+  out["convert_s"] = r.wall_s - r.seconds;
+  out["source_keypoints"] = r.source_points;
+  out["target_keypoints"] = r.target_points;
+  report_unrefined(job, pair, r.transform, json(r.stages), out);
 }
 
 // ETH office: the clouds are keypoints already; only the 4PCS stage runs.
@@ -363,6 +410,10 @@ json run_job(const Job& job) {
     out["read_s"] = pair.read_s;
     if (job.method == kOursK4pcs || job.method == kOursPlain) run_ours(job, pair, out);
     else if (job.method == kPclK4pcs || job.method == kPclPlain) run_pcl(job, pair, out);
+    else if (job.method == kPclSacIa)
+      run_sac_ia(job, pair, out);
+    else if (job.method == kOpen3dRansac || job.method == kOpen3dFgr)
+      run_open3d(job, pair, out);
     else if (job.method == kOursMatch || job.method == kPclMatch) run_match(job, pair, out);
     else if (job.method == kKeypointsOurs || job.method == kKeypointsPcl) run_keypoints(job, pair, out);
     else throw std::runtime_error("unknown method " + job.method);
