@@ -1,5 +1,7 @@
 #include "k4reg/registration/free_space.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -54,13 +56,22 @@ FreeSpaceImage::FreeSpaceImage(const std::vector<Eigen::Vector3f>& points, const
   std::vector<std::size_t> per_row(rows_, 0);
   sampled_ranges.reserve(points.size() / kRangeSampleEvery + 1);
   std::size_t returns = 0;
-  for (const Eigen::Vector3f& p : points) {
-    const Located at = locate(p);
-    if (at.cell < 0) continue;
-    float& nearest = nearest_[at.cell];
-    nearest = std::min(nearest, at.range);
-    if (returns++ % kRangeSampleEvery == 0) sampled_ranges.push_back(at.range);
-    ++per_row[at.cell / columns_];
+  // Located in parallel (an arc tangent or two per point), a block at a time, and folded in the points' order.
+  constexpr std::size_t kBlock = 1 << 16;
+  std::vector<Located> located(std::min(points.size(), kBlock));
+  for (std::size_t first = 0; first < points.size(); first += kBlock) {
+    const std::size_t count = std::min(kBlock, points.size() - first);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 4096), [&](const auto& range) {
+      for (std::size_t k = range.begin(); k != range.end(); ++k) located[k] = locate(points[first + k]);
+    });
+    for (std::size_t k = 0; k < count; ++k) {
+      const Located& at = located[k];
+      if (at.cell < 0) continue;
+      float& nearest = nearest_[at.cell];
+      nearest = std::min(nearest, at.range);
+      if (returns++ % kRangeSampleEvery == 0) sampled_ranges.push_back(at.range);
+      ++per_row[at.cell / columns_];
+    }
   }
   // Each cell takes the nearest return of its 3 x 3 neighbourhood. A cell's few returns may all lie at
   // its far side: on a surface seen at grazing incidence the range changes by metres across one cell,
