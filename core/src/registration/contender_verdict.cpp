@@ -37,6 +37,7 @@ Verdict judge_contenders(const SymmetryGuardResult& guarded, const ContenderJudg
   const Eigen::Vector3d source_centre = centroid(source.stages.front().points);  // where poses are compared
   IcpParams contender_params = judging.final_params;
   contender_params.converged_step_voxels = kSettledStepVoxels;
+  contender_params.measure_fit = false;  // scored below
   std::vector<IcpResult> refined(contenders);
   stages.run("icp", [&] {
     tbb::parallel_for(std::size_t{0}, contenders, [&](std::size_t i) {

@@ -34,6 +34,7 @@ IcpResult polish_winner(const PreparedScan& source, const PreparedScan& target, 
   IcpParams fine = params;
   fine.stages = 1;
   fine.converged_step_voxels = params.converged_step_voxels * sigma_m / target_m;
+  fine.measure_fit = false;  // the figures come from sigma's stage below
   const IcpResult finer =
       refine_icp(thin_pyramid(source.pyramid(source_m, fine, PyramidRole::kSource, cancel), kFinePolishSourcePoints),
                  target.pyramid(target_m, fine, PyramidRole::kTarget, cancel), polished.transform, fine, cancel);

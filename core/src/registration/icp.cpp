@@ -191,7 +191,7 @@ IcpResult refine_icp(const IcpPyramid& source, const IcpPyramid& target, const E
         break;
       }
     }
-    if (stage + 1 == stages) {
+    if (stage + 1 == stages && params.measure_fit) {
       const Accumulation acc = accumulate(src.points, tgt.points, tgt.normals, *tgt.grid, result.transform,
                                           Pivot(centre, result.transform), max_distance, voxel);
       result.inliers = acc.inliers;

@@ -172,6 +172,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   quick.max_iterations = kIterations;
   quick.levelled = options.levelled;
   quick.converged_step_voxels = kSettledStepVoxels;
+  quick.measure_fit = false;  // settling needs the pose only: the score follows
   // A hypothesis can be a metre or two off where it matters, beyond the guard's ICP stages: a 4PCS fit on
   // keypoints a few metres apart tilts a wide outdoor scene by degrees, and a twin's estimated centre is
   // rough. Two wider stages (2 and 4 times the pyramid's coarsest spacing, a few thousand points) reach
@@ -183,6 +184,7 @@ SymmetryGuardResult rank_hypotheses(const IcpPyramid& source, const IcpPyramid& 
   wide.max_iterations = 10;
   wide.levelled = options.levelled;
   wide.converged_step_voxels = kSettledStepVoxels;
+  wide.measure_fit = false;
   const IcpPyramid wide_source =
       thin_pyramid(make_icp_pyramid(source.stages.front().points, wide, PyramidRole::kSource, cancel), kSettlePoints);
   const IcpPyramid wide_target = make_icp_pyramid(target.stages.front().points, wide, PyramidRole::kTarget, cancel);

@@ -23,6 +23,9 @@ struct IcpParams {
   // A stage has converged once a step moves the cloud by less than this many stage voxels (and turns it by less
   // than a hundredth of that in radians).
   double converged_step_voxels = 1e-4;
+  // One more pass at the end for the fit figures (rmse_m, overlap, inliers, translation_information); callers that
+  // keep only the pose (the symmetry guard's settling, the contenders, the fine polish's finer stage) skip it.
+  bool measure_fit = true;
 };
 
 // Converged enough to compare poses (the symmetry guard, contenders for the verdict); a winner is polished after.
