@@ -24,49 +24,41 @@ Eigen::Matrix4d proposed_pose(const ProjectResult& r, const ProjectLink& link, s
                              : r.scans[link.source].pose * rigid_inverse(link.transform);
 }
 
-// Initial poses by consensus, one scan at a time from the reference: every accepted link from an unplaced
-// scan to a placed one proposes a pose, and each proposal counts the proposals that agree with it (within
-// the two links' tolerances). A scan is placed only where a strict majority of its links agree; the best
-// supported proposal of all goes first (then more loops closed, better support, lower link index). A wrong
-// link that slipped through the loops is outvoted here rather than carried along a spanning tree. Scans
-// that never gain a majority stay unregistered.
-void place_scans(ProjectResult& r, const std::vector<ScanExtent>& extents) {
-  for (ProjectScan& scan : r.scans) {
-    scan.registered = scan.ambiguous = false;
-    scan.pose = Eigen::Matrix4d::Identity();
-    scan.reason.clear();
-    scan.candidate_poses.clear();
+// Where the accepted links to already placed scans put scan x: the proposal most of the others agree with
+// (within the two links' tolerances), and of those the one nearest the rest (least sum of squared displacements,
+// each in units of that tolerance). A link a few of its tolerances off still agrees with the true ones, but lies
+// farther from each of them than they lie from each other. None where no proposal has a strict majority.
+struct Consensus {
+  std::size_t votes = 0, link = 0;
+  Eigen::Matrix4d pose;
+};
+
+std::optional<Consensus> consensus(const ProjectResult& r, std::size_t x, const std::vector<ScanExtent>& extents) {
+  std::vector<std::pair<std::size_t, Eigen::Matrix4d>> proposals;  // link, pose
+  for (std::size_t l : r.scans[x].links) {
+    const ProjectLink& link = r.links[l];
+    if (r.scans[link.source == x ? link.target : link.source].registered)
+      proposals.emplace_back(l, proposed_pose(r, link, x));
   }
-  r.scans[r.reference].registered = true;
-  using Key = std::tuple<std::size_t, int, double, std::size_t>;  // votes, loops closed, score, -link
-  for (;;) {
-    std::optional<std::pair<Key, std::pair<std::size_t, Eigen::Matrix4d>>> best;  // key, (scan, pose)
-    for (std::size_t x = 0; x < r.scans.size(); ++x) {
-      if (r.scans[x].registered) continue;
-      std::vector<std::pair<std::size_t, Eigen::Matrix4d>> proposals;  // link, pose
-      for (std::size_t l : r.scans[x].links) {
-        const ProjectLink& link = r.links[l];
-        if (r.scans[link.source == x ? link.target : link.source].registered)
-          proposals.emplace_back(l, proposed_pose(r, link, x));
-      }
-      for (const auto& [l, pose] : proposals) {
-        std::size_t votes = 0;
-        for (const auto& [m, other] : proposals)
-          votes += displacement_m(rigid_inverse(pose) * other, extents[x]) <=
-                   kLoopToleranceFactor * std::hypot(link_tolerance_m(r.links[l]), link_tolerance_m(r.links[m]));
-        if (2 * votes <= proposals.size()) continue;
-        const Key key{votes, r.links[l].loops_closed, r.links[l].cloud_score, r.links.size() - l};
-        if (!best || key > best->first) best = {key, {x, pose}};
-      }
+  std::optional<Consensus> best;
+  double best_spread = 0.0;
+  for (const auto& [l, pose] : proposals) {
+    std::size_t votes = 0;
+    double spread = 0.0;
+    for (const auto& [m, other] : proposals) {
+      const double apart = displacement_m(rigid_inverse(pose) * other, extents[x]) /
+                           std::hypot(link_tolerance_m(r.links[l]), link_tolerance_m(r.links[m]));
+      if (apart > kLoopToleranceFactor) continue;
+      ++votes;
+      spread += apart * apart;
     }
-    if (!best) break;
-    r.scans[best->second.first].pose = best->second.second;
-    r.scans[best->second.first].registered = true;
+    if (2 * votes <= proposals.size()) continue;
+    if (!best || votes > best->votes || (votes == best->votes && spread < best_spread)) {
+      best = Consensus{votes, l, pose};
+      best_spread = spread;
+    }
   }
-  for (ProjectScan& scan : r.scans)
-    if (!scan.registered)
-      scan.reason = scan.links.empty() ? "no accepted link connects it to the others (see its links' reasons)"
-                                       : "its accepted links do not agree on where it goes, or reach the reference";
+  return best;
 }
 
 // Rejects an accepted link: it leaves its scans' lists.
@@ -180,13 +172,57 @@ void adopt_refinement(ProjectResult& r, const LinkGraph& graph, const PoseGraphR
 
 }  // namespace
 
+void place_by_consensus(ProjectResult& r, const std::vector<ScanExtent>& extents) {
+  for (ProjectScan& scan : r.scans) {
+    scan.registered = scan.ambiguous = false;
+    scan.pose = Eigen::Matrix4d::Identity();
+    scan.reason.clear();
+    scan.candidate_poses.clear();
+  }
+  r.scans[r.reference].registered = true;
+  std::vector<std::size_t> placed_by(r.scans.size(), r.links.size());  // the link whose proposal placed each scan
+  using Key = std::tuple<std::size_t, int, double, std::size_t>;       // votes, loops closed, score, -link
+  for (;;) {
+    std::optional<std::pair<Key, std::pair<std::size_t, Consensus>>> best;  // key, (scan, consensus)
+    for (std::size_t x = 0; x < r.scans.size(); ++x) {
+      if (r.scans[x].registered) continue;
+      const std::optional<Consensus> c = consensus(r, x, extents);
+      if (!c) continue;
+      const Key key{c->votes, r.links[c->link].loops_closed, r.links[c->link].cloud_score, r.links.size() - c->link};
+      if (!best || key > best->first) best = {key, {x, *c}};
+    }
+    if (!best) break;
+    const auto& [x, c] = best->second;
+    r.scans[x].pose = c.pose;
+    r.scans[x].registered = true;
+    placed_by[x] = c.link;
+  }
+  // Each pass moves only scans whose consensus now rests on another link; a few passes settle a project.
+  for (std::size_t pass = 0; pass < r.scans.size(); ++pass) {
+    bool moved = false;
+    for (std::size_t x = 0; x < r.scans.size(); ++x) {
+      if (!r.scans[x].registered || x == r.reference) continue;
+      const std::optional<Consensus> c = consensus(r, x, extents);
+      if (!c || c->link == placed_by[x]) continue;
+      r.scans[x].pose = c->pose;
+      placed_by[x] = c->link;
+      moved = true;
+    }
+    if (!moved) break;
+  }
+  for (ProjectScan& scan : r.scans)
+    if (!scan.registered)
+      scan.reason = scan.links.empty() ? "no accepted link connects it to the others (see its links' reasons)"
+                                       : "its accepted links do not agree on where it goes, or reach the reference";
+}
+
 void place_and_refine(const ProjectInputs& in, const std::vector<LinkCandidates>& candidates, bool levelled,
                       ProjectResult& r) {
   const StageTimer timer(r.timings, "refinement");
   if (in.progress) in.progress("refinement", 0.0);
   for (;;) {
     check(in.cancel);
-    place_scans(r, in.extents);
+    place_by_consensus(r, in.extents);
     LinkGraph graph = graph_of_agreeing_links(r, in.extents);
     // Scans that a confident pairwise result contradicts leave the project (scan_conflicts.h).
     refuse_conflicted_scans(r, in.extents);

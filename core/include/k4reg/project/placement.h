@@ -14,6 +14,15 @@
 
 namespace k4reg {
 
+// Initial poses by consensus, one scan at a time from the reference: every accepted link from an unplaced scan to
+// a placed one proposes a pose; a scan is placed only where a strict majority of its links agree (within the two
+// links' tolerances), at the proposal nearest the others that agree, and the best supported consensus of all goes
+// first (then more loops closed, better support, lower link index). A wrong link that slipped through the loops is
+// outvoted here rather than carried along a spanning tree. Then every scan is placed again by the consensus of all
+// its placed neighbours, until none moves: a scan placed early, on its one link to the reference, is not left where
+// that link alone put it. Sets each scan's pose and registered, and a reason for those that never gain a majority.
+void place_by_consensus(ProjectResult& result, const std::vector<ScanExtent>& extents);
+
 // Sets every scan's pose, registered, reason, strength, candidate poses and constraint, the accepted links'
 // residuals (rejecting those the placement or the refined project contradicts) and result.global_rmse_m and
 // scans_registered. levelled: the refinement turns scans about z only.
