@@ -13,25 +13,28 @@ namespace {
 
 Eigen::Matrix4d shifted(double x) { return Eigen::Affine3d(Eigen::Translation3d(x, 0.0, 0.0)).matrix(); }
 
-// Five scans 2 m apart along x, every pair linked by its true transform (tolerance 0.1 m each: two links agree
-// within 3 x hypot(0.1, 0.1) = 0.42 m), each link accepted and in its scans' lists.
+// Links scans s and t by their true transform (tolerance 2 x min_scale_m), accepted and in both scans' lists.
+void add_link(ProjectResult& r, const std::vector<Eigen::Matrix4d>& truth, std::size_t s, std::size_t t,
+              double min_scale_m = 0.05) {
+  ProjectLink link;
+  link.source = s, link.target = t, link.accepted = true;
+  link.transform = rigid_inverse(truth[t]) * truth[s];
+  link.verdict = LinkVerdict::kConfirmed;
+  link.min_scale_m_used = min_scale_m;
+  link.loops_closed = 1;
+  r.scans[s].links.push_back(r.links.size());
+  r.scans[t].links.push_back(r.links.size());
+  r.links.push_back(link);
+}
+
+// Five scans 2 m apart along x (truth), every pair linked (tolerance 0.1 m each: two links agree within
+// 3 x hypot(0.1, 0.1) = 0.42 m).
 ProjectResult linked_project(std::vector<Eigen::Matrix4d>& truth) {
   ProjectResult r;
-  const std::size_t n = 5;
-  r.scans.resize(n);
-  for (std::size_t i = 0; i < n; ++i) truth.push_back(shifted(2.0 * i));
-  for (std::size_t s = 0; s < n; ++s)
-    for (std::size_t t = s + 1; t < n; ++t) {
-      ProjectLink link;
-      link.source = s, link.target = t, link.accepted = true;
-      link.transform = rigid_inverse(truth[t]) * truth[s];
-      link.verdict = LinkVerdict::kConfirmed;
-      link.min_scale_m_used = 0.05;
-      link.loops_closed = 1;
-      r.scans[s].links.push_back(r.links.size());
-      r.scans[t].links.push_back(r.links.size());
-      r.links.push_back(link);
-    }
+  r.scans.resize(5);
+  for (std::size_t i = 0; i < r.scans.size(); ++i) truth.push_back(shifted(2.0 * i));
+  for (std::size_t s = 0; s < r.scans.size(); ++s)
+    for (std::size_t t = s + 1; t < r.scans.size(); ++t) add_link(r, truth, s, t);
   return r;
 }
 
@@ -57,6 +60,24 @@ TEST(Placement, AgreeingLinksPlaceEveryScanWhereTheyPutIt) {
 TEST(Placement, AScanPlacedFirstOnOneSlightlyWrongLinkIsPlacedAgainByAllItsNeighbours) {
   std::vector<Eigen::Matrix4d> truth;
   ProjectResult r = linked_project(truth);
+  r.links[0].transform = shifted(0.35) * r.links[0].transform;  // 0 -> 1
+  r.links[0].loops_closed = 5;
+  place_by_consensus(r, kExtents);
+  expect_every_scan_at_its_truth(r, truth);
+}
+
+// Scan 4 is linked to scans 1 and 3 only, by precise links (tolerance 0.02 m: they agree within 0.085 m). Scan 1
+// is placed first, 0.35 m off, so the two disagree and scan 4 waits; once scan 1 is placed again by all its
+// neighbours, they agree and scan 4 is placed.
+TEST(Placement, AScanWaitingOnAMisplacedNeighbourIsPlacedOnceThatNeighbourMoves) {
+  std::vector<Eigen::Matrix4d> truth;
+  ProjectResult r;
+  r.scans.resize(5);
+  for (std::size_t i = 0; i < r.scans.size(); ++i) truth.push_back(shifted(2.0 * i));
+  for (std::size_t s = 0; s < 4; ++s)
+    for (std::size_t t = s + 1; t < 4; ++t) add_link(r, truth, s, t);
+  add_link(r, truth, 1, 4, 0.01);
+  add_link(r, truth, 3, 4, 0.01);
   r.links[0].transform = shifted(0.35) * r.links[0].transform;  // 0 -> 1
   r.links[0].loops_closed = 5;
   place_by_consensus(r, kExtents);

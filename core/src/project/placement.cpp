@@ -61,6 +61,42 @@ std::optional<Consensus> consensus(const ProjectResult& r, std::size_t x, const 
   return best;
 }
 
+// Places unplaced scans one at a time, the best supported consensus of all first (then more loops closed, better
+// support, lower link index); placed_by: per scan, the link whose proposal placed it.
+void place_the_unplaced(ProjectResult& r, const std::vector<ScanExtent>& extents, std::vector<std::size_t>& placed_by) {
+  using Key = std::tuple<std::size_t, int, double, std::size_t>;  // votes, loops closed, score, -link
+  for (;;) {
+    std::optional<std::pair<Key, std::pair<std::size_t, Consensus>>> best;  // key, (scan, consensus)
+    for (std::size_t x = 0; x < r.scans.size(); ++x) {
+      if (r.scans[x].registered) continue;
+      const std::optional<Consensus> c = consensus(r, x, extents);
+      if (!c) continue;
+      const Key key{c->votes, r.links[c->link].loops_closed, r.links[c->link].cloud_score, r.links.size() - c->link};
+      if (!best || key > best->first) best = {key, {x, *c}};
+    }
+    if (!best) return;
+    const auto& [x, c] = best->second;
+    r.scans[x].pose = c.pose;
+    r.scans[x].registered = true;
+    placed_by[x] = c.link;
+  }
+}
+
+// Places every placed scan again by the consensus of all its placed neighbours; whether one moved (its consensus
+// now rests on another link).
+bool place_again(ProjectResult& r, const std::vector<ScanExtent>& extents, std::vector<std::size_t>& placed_by) {
+  bool moved = false;
+  for (std::size_t x = 0; x < r.scans.size(); ++x) {
+    if (!r.scans[x].registered || x == r.reference) continue;
+    const std::optional<Consensus> c = consensus(r, x, extents);
+    if (!c || c->link == placed_by[x]) continue;
+    r.scans[x].pose = c->pose;
+    placed_by[x] = c->link;
+    moved = true;
+  }
+  return moved;
+}
+
 // Rejects an accepted link: it leaves its scans' lists.
 void reject(ProjectResult& r, std::size_t l, const std::string& reason) {
   ProjectLink& link = r.links[l];
@@ -180,35 +216,11 @@ void place_by_consensus(ProjectResult& r, const std::vector<ScanExtent>& extents
     scan.candidate_poses.clear();
   }
   r.scans[r.reference].registered = true;
-  std::vector<std::size_t> placed_by(r.scans.size(), r.links.size());  // the link whose proposal placed each scan
-  using Key = std::tuple<std::size_t, int, double, std::size_t>;       // votes, loops closed, score, -link
-  for (;;) {
-    std::optional<std::pair<Key, std::pair<std::size_t, Consensus>>> best;  // key, (scan, consensus)
-    for (std::size_t x = 0; x < r.scans.size(); ++x) {
-      if (r.scans[x].registered) continue;
-      const std::optional<Consensus> c = consensus(r, x, extents);
-      if (!c) continue;
-      const Key key{c->votes, r.links[c->link].loops_closed, r.links[c->link].cloud_score, r.links.size() - c->link};
-      if (!best || key > best->first) best = {key, {x, *c}};
-    }
-    if (!best) break;
-    const auto& [x, c] = best->second;
-    r.scans[x].pose = c.pose;
-    r.scans[x].registered = true;
-    placed_by[x] = c.link;
-  }
-  // Each pass moves only scans whose consensus now rests on another link; a few passes settle a project.
-  for (std::size_t pass = 0; pass < r.scans.size(); ++pass) {
-    bool moved = false;
-    for (std::size_t x = 0; x < r.scans.size(); ++x) {
-      if (!r.scans[x].registered || x == r.reference) continue;
-      const std::optional<Consensus> c = consensus(r, x, extents);
-      if (!c || c->link == placed_by[x]) continue;
-      r.scans[x].pose = c->pose;
-      placed_by[x] = c->link;
-      moved = true;
-    }
-    if (!moved) break;
+  std::vector<std::size_t> placed_by(r.scans.size(), r.links.size());
+  // A scan moved may give another its majority, and a scan placed may move another: a few rounds settle a project.
+  for (std::size_t round = 0; round < r.scans.size(); ++round) {
+    place_the_unplaced(r, extents, placed_by);
+    if (!place_again(r, extents, placed_by)) break;
   }
   for (ProjectScan& scan : r.scans)
     if (!scan.registered)

@@ -19,8 +19,9 @@ namespace k4reg {
 // links' tolerances), at the proposal nearest the others that agree, and the best supported consensus of all goes
 // first (then more loops closed, better support, lower link index). A wrong link that slipped through the loops is
 // outvoted here rather than carried along a spanning tree. Then every scan is placed again by the consensus of all
-// its placed neighbours, until none moves: a scan placed early, on its one link to the reference, is not left where
-// that link alone put it. Sets each scan's pose and registered, and a reason for those that never gain a majority.
+// its placed neighbours (a scan placed early, on its one link to the reference, is not left where that link alone
+// put it), the scans still unplaced are tried again, and so on until nothing moves. Sets each scan's pose and
+// registered, and a reason for those that never gain a majority. Cost: O(links per scan ^ 2) per scan and round.
 void place_by_consensus(ProjectResult& result, const std::vector<ScanExtent>& extents);
 
 // Sets every scan's pose, registered, reason, strength, candidate poses and constraint, the accepted links'
