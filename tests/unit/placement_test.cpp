@@ -27,15 +27,22 @@ void add_link(ProjectResult& r, const std::vector<Eigen::Matrix4d>& truth, std::
   r.links.push_back(link);
 }
 
-// Five scans 2 m apart along x (truth), every pair linked (tolerance 0.1 m each: two links agree within
-// 3 x hypot(0.1, 0.1) = 0.42 m).
-ProjectResult linked_project(std::vector<Eigen::Matrix4d>& truth) {
+// Five scans 2 m apart along x (truth), every pair among the first `linked` linked (tolerance 0.1 m each: two
+// links agree within 3 x hypot(0.1, 0.1) = 0.42 m).
+ProjectResult linked_project(std::vector<Eigen::Matrix4d>& truth, std::size_t linked = 5) {
   ProjectResult r;
   r.scans.resize(5);
   for (std::size_t i = 0; i < r.scans.size(); ++i) truth.push_back(shifted(2.0 * i));
-  for (std::size_t s = 0; s < r.scans.size(); ++s)
-    for (std::size_t t = s + 1; t < r.scans.size(); ++t) add_link(r, truth, s, t);
+  for (std::size_t s = 0; s < linked; ++s)
+    for (std::size_t t = s + 1; t < linked; ++t) add_link(r, truth, s, t);
   return r;
+}
+
+// Link 0 (0 -> 1) 0.35 m off (within what two links' tolerances let agree, beyond what one link's allows), and
+// closing the most loops, so that scan 1 is placed first, on it alone.
+void misplace_scan_one_first(ProjectResult& r) {
+  r.links[0].transform = shifted(0.35) * r.links[0].transform;
+  r.links[0].loops_closed = 5;
 }
 
 const std::vector<ScanExtent> kExtents(5, {Eigen::Vector3d::Zero(), 10.0});
@@ -54,14 +61,12 @@ TEST(Placement, AgreeingLinksPlaceEveryScanWhereTheyPutIt) {
   expect_every_scan_at_its_truth(r, truth);
 }
 
-// The link from the reference to scan 1 is 0.35 m off (within what two links' tolerances let agree, beyond what
-// one link's allows) and closes the most loops, so scan 1 is placed first, on it alone. Once its other
-// neighbours are placed, the proposals they agree on put it back where the true links do.
+// Scan 1 is placed first on its slightly wrong link to the reference. Once its other neighbours are placed, the
+// proposals they agree on put it back where the true links do.
 TEST(Placement, AScanPlacedFirstOnOneSlightlyWrongLinkIsPlacedAgainByAllItsNeighbours) {
   std::vector<Eigen::Matrix4d> truth;
   ProjectResult r = linked_project(truth);
-  r.links[0].transform = shifted(0.35) * r.links[0].transform;  // 0 -> 1
-  r.links[0].loops_closed = 5;
+  misplace_scan_one_first(r);
   place_by_consensus(r, kExtents);
   expect_every_scan_at_its_truth(r, truth);
 }
@@ -71,15 +76,10 @@ TEST(Placement, AScanPlacedFirstOnOneSlightlyWrongLinkIsPlacedAgainByAllItsNeigh
 // neighbours, they agree and scan 4 is placed.
 TEST(Placement, AScanWaitingOnAMisplacedNeighbourIsPlacedOnceThatNeighbourMoves) {
   std::vector<Eigen::Matrix4d> truth;
-  ProjectResult r;
-  r.scans.resize(5);
-  for (std::size_t i = 0; i < r.scans.size(); ++i) truth.push_back(shifted(2.0 * i));
-  for (std::size_t s = 0; s < 4; ++s)
-    for (std::size_t t = s + 1; t < 4; ++t) add_link(r, truth, s, t);
+  ProjectResult r = linked_project(truth, 4);
   add_link(r, truth, 1, 4, 0.01);
   add_link(r, truth, 3, 4, 0.01);
-  r.links[0].transform = shifted(0.35) * r.links[0].transform;  // 0 -> 1
-  r.links[0].loops_closed = 5;
+  misplace_scan_one_first(r);
   place_by_consensus(r, kExtents);
   expect_every_scan_at_its_truth(r, truth);
 }
